@@ -1,0 +1,434 @@
+/* carom.h - the whole public, stable C API of carom, a rigid-body collision
+ * library. Double precision, SI units, z up.
+ *
+ * Stability rules: the def and settings structs start with a `size` field that
+ * their static inline default functions stamp with the caller's compile-time
+ * size; the library reads only that many bytes and defaults the rest. New
+ * fields are only ever appended. Ids are values (index + generation), never
+ * pointers: a stale id is detected and rejected. */
+#ifndef CAROM_CAROM_H
+#define CAROM_CAROM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(CAROM_BUILDING) && defined(__GNUC__)
+#define CAROM_API __attribute__((visibility("default")))
+#else
+#define CAROM_API
+#endif
+
+#define CAROM_VERSION_MAJOR 1
+#define CAROM_VERSION_MINOR 0
+#define CAROM_VERSION_PATCH 0
+
+/* ---- values ------------------------------------------------------------ */
+
+typedef struct carom_vec3 { double x, y, z; } carom_vec3;
+/* Unit quaternion, w first. */
+typedef struct carom_quat { double w, x, y, z; } carom_quat;
+
+typedef enum carom_status {
+    CAROM_OK = 0,
+    CAROM_ERROR_INVALID_ARGUMENT = 1, /* NaN/inf, out of range, NULL, bad def */
+    CAROM_ERROR_STALE_ID = 2,         /* the body was destroyed (or never existed) */
+    CAROM_ERROR_LOCKED = 3,           /* the world is inside its step or a callback */
+    CAROM_ERROR_OUT_OF_MEMORY = 4,
+    CAROM_ERROR_UNSUPPORTED = 5       /* e.g. an operation a static body cannot do */
+} carom_status;
+
+/* A body id: index1 is the id slot + 1 (0 = null id); the generation changes
+ * when the slot is reused, so an old id stays invalid forever. */
+typedef struct carom_body_id {
+    uint32_t index1;
+    uint32_t generation;
+} carom_body_id;
+
+static inline carom_body_id carom_null_body(void)
+{
+    carom_body_id id = {0, 0};
+    return id;
+}
+static inline int carom_body_id_is_null(carom_body_id id) { return id.index1 == 0; }
+static inline uint64_t carom_body_id_pack(carom_body_id id)
+{
+    return ((uint64_t)id.generation << 32) | (uint64_t)id.index1;
+}
+static inline carom_body_id carom_body_id_unpack(uint64_t v)
+{
+    carom_body_id id;
+    id.index1 = (uint32_t)(v & 0xffffffffu);
+    id.generation = (uint32_t)(v >> 32);
+    return id;
+}
+static inline int carom_body_id_equal(carom_body_id a, carom_body_id b)
+{
+    return a.index1 == b.index1 && a.generation == b.generation;
+}
+
+typedef struct carom_world carom_world;
+
+/* ---- library ----------------------------------------------------------- */
+
+/* "1.0.0" */
+CAROM_API const char *carom_version(void);
+/* Human-readable name of a status. */
+CAROM_API const char *carom_status_string(carom_status status);
+
+/* ---- world ------------------------------------------------------------- */
+
+typedef enum carom_position_correction {
+    CAROM_CORRECTION_SOFT = 0,      /* soft contacts (spring-damper in the constraint) */
+    CAROM_CORRECTION_BAUMGARTE = 1, /* velocity bias beta * penetration / h */
+    CAROM_CORRECTION_NONE = 2
+} carom_position_correction;
+
+typedef enum carom_contact_model {
+    CAROM_CONTACT_IMPULSE = 0,      /* sequential impulses (rigid, the seed's classical method) */
+    CAROM_CONTACT_PENALTY = 1       /* the seed's penalty springs */
+} carom_contact_model;
+
+typedef struct carom_contact_event carom_contact_event;
+/* Called once per buffered event at the end of carom_world_step, while the
+ * world is locked: creating bodies fails with CAROM_ERROR_LOCKED, destroying
+ * is deferred to the end of the step, other setters are refused. */
+typedef void carom_event_fn(void *context, const carom_contact_event *event);
+
+typedef struct carom_world_def {
+    uint32_t size;                      /* sizeof(carom_world_def), stamped by the default */
+    carom_vec3 gravity;                 /* (0, 0, -9.81) */
+    int substeps;                       /* 4: sub-steps per step (soft step) */
+    int iterations;                     /* 1: velocity iterations per sub-step */
+    int relax_iterations;               /* 1: relax passes per sub-step (0 = off) */
+    carom_position_correction position_correction; /* SOFT */
+    int warm_starting;                  /* 1 */
+    double restitution_threshold;       /* 1.0 m/s: slower impacts do not bounce */
+    double contact_hertz;               /* 30: soft contact stiffness */
+    double contact_damping_ratio;       /* 10 */
+    double contact_push_max_velocity;   /* 3 m/s: cap on the speed of push-out */
+    double baumgarte;                   /* 0.2: beta for BAUMGARTE correction */
+    double linear_slop;                 /* 0.005 m: allowed overlap */
+    double speculative_distance;        /* 0.02 m: contacts exist this far before touching */
+    carom_contact_model contact_model;  /* IMPULSE */
+    double penalty_stiffness;           /* 0: auto (from contact_hertz and masses); else N/m */
+    double penalty_damping;             /* 0: auto (critical from damping ratio 1); else N s/m */
+    int penalty_implicit;               /* 1: implicit spring (stable); 0: explicit */
+    int shock_propagation;              /* 1: bodies nearer the ground act immovable in a last
+                                           bottom-up pass (holds large mass ratios) */
+    int enable_friction;                /* 1 */
+    int enable_restitution;             /* 1 */
+    int enable_sleep;                   /* 1 */
+    int enable_continuous;              /* 1: time of impact for fast and bullet bodies */
+    double sleep_time;                  /* 0.5 s at rest before an island sleeps */
+    double sleep_linear_velocity;       /* 0.05 m/s */
+    double sleep_angular_velocity;      /* 0.05 rad/s */
+    double max_linear_speed;            /* 4000 m/s: clamp; clamping raises stats.clamped */
+    double max_angular_speed;           /* 1000 rad/s */
+    int body_capacity;                  /* 0: initial storage hint */
+    carom_event_fn *event_callback;     /* NULL: events are only buffered */
+    void *event_context;
+} carom_world_def;
+
+static inline carom_world_def carom_world_def_default(void)
+{
+    carom_world_def d;
+    d.size = (uint32_t)sizeof(carom_world_def);
+    d.gravity.x = 0.0; d.gravity.y = 0.0; d.gravity.z = -9.81;
+    d.substeps = 4;
+    d.iterations = 1;
+    d.relax_iterations = 1;
+    d.position_correction = CAROM_CORRECTION_SOFT;
+    d.warm_starting = 1;
+    d.restitution_threshold = 1.0;
+    d.contact_hertz = 30.0;
+    d.contact_damping_ratio = 10.0;
+    d.contact_push_max_velocity = 3.0;
+    d.baumgarte = 0.2;
+    d.linear_slop = 0.005;
+    d.speculative_distance = 0.02;
+    d.contact_model = CAROM_CONTACT_IMPULSE;
+    d.penalty_stiffness = 0.0;
+    d.penalty_damping = 0.0;
+    d.penalty_implicit = 1;
+    d.shock_propagation = 1;
+    d.enable_friction = 1;
+    d.enable_restitution = 1;
+    d.enable_sleep = 1;
+    d.enable_continuous = 1;
+    d.sleep_time = 0.5;
+    d.sleep_linear_velocity = 0.05;
+    d.sleep_angular_velocity = 0.05;
+    d.max_linear_speed = 4000.0;
+    d.max_angular_speed = 1000.0;
+    d.body_capacity = 0;
+    d.event_callback = 0;
+    d.event_context = 0;
+    return d;
+}
+
+/* Overwrites the solver fields of def with a named preset: "fast",
+ * "default" or "accurate" (see README, "Choosing settings"). Only the first
+ * def->size bytes are written. */
+CAROM_API carom_status carom_world_def_apply_preset(carom_world_def *def, const char *preset);
+/* Checks a def; on error writes a readable message to msg (if not NULL). */
+CAROM_API carom_status carom_world_def_check(const carom_world_def *def, char *msg, size_t msg_size);
+
+/* NULL when def is invalid (carom_world_def_check says why) or out of memory. */
+CAROM_API carom_world *carom_world_create(const carom_world_def *def);
+CAROM_API void carom_world_destroy(carom_world *world);
+/* Message of the last failed call on this world ("" if none). */
+CAROM_API const char *carom_world_last_error(const carom_world *world);
+/* Replaces the world's settings (gravity, solver knobs, switches) between steps. */
+CAROM_API carom_status carom_world_set_def(carom_world *world, const carom_world_def *def);
+/* Copies the world's settings into def (def->size must be set). */
+CAROM_API carom_status carom_world_get_def(const carom_world *world, carom_world_def *def);
+/* Advances the world by dt seconds (0 < dt <= 1). */
+CAROM_API carom_status carom_world_step(carom_world *world, double dt);
+CAROM_API int carom_world_body_count(const carom_world *world);
+
+/* ---- bodies ------------------------------------------------------------ */
+
+typedef enum carom_body_type {
+    CAROM_BODY_STATIC = 0,
+    CAROM_BODY_KINEMATIC = 1,
+    CAROM_BODY_DYNAMIC = 2
+} carom_body_type;
+
+typedef enum carom_shape_type {
+    CAROM_SHAPE_SPHERE = 0,   /* radius */
+    CAROM_SHAPE_BOX = 1,      /* half_extents */
+    CAROM_SHAPE_CAPSULE = 2,  /* radius, half_height: segment on the local z axis */
+    CAROM_SHAPE_CYLINDER = 3, /* radius, half_height: axis local z */
+    CAROM_SHAPE_HULL = 4,     /* points (x,y,z triples), point_count >= 4, not coplanar */
+    CAROM_SHAPE_PLANE = 5     /* static only: dot(normal, x) = offset; solid where < offset */
+} carom_shape_type;
+
+typedef struct carom_shape_def {
+    carom_shape_type type;
+    double radius;
+    double half_height;
+    carom_vec3 half_extents;
+    const double *points;     /* hull: copied at body creation */
+    int point_count;
+    carom_vec3 normal;        /* plane, body frame (need not be unit; not zero) */
+    double offset;
+} carom_shape_def;
+
+static inline carom_shape_def carom_shape_sphere(double radius)
+{
+    carom_shape_def s = {CAROM_SHAPE_SPHERE, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.radius = radius;
+    return s;
+}
+static inline carom_shape_def carom_shape_box(double hx, double hy, double hz)
+{
+    carom_shape_def s = {CAROM_SHAPE_BOX, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.half_extents.x = hx; s.half_extents.y = hy; s.half_extents.z = hz;
+    return s;
+}
+static inline carom_shape_def carom_shape_capsule(double radius, double half_height)
+{
+    carom_shape_def s = {CAROM_SHAPE_CAPSULE, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.radius = radius; s.half_height = half_height;
+    return s;
+}
+static inline carom_shape_def carom_shape_cylinder(double radius, double half_height)
+{
+    carom_shape_def s = {CAROM_SHAPE_CYLINDER, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.radius = radius; s.half_height = half_height;
+    return s;
+}
+static inline carom_shape_def carom_shape_hull(const double *points, int point_count)
+{
+    carom_shape_def s = {CAROM_SHAPE_HULL, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.points = points; s.point_count = point_count;
+    return s;
+}
+static inline carom_shape_def carom_shape_plane(double nx, double ny, double nz, double offset)
+{
+    carom_shape_def s = {CAROM_SHAPE_PLANE, 0, 0, {0, 0, 0}, 0, 0, {0, 0, 1}, 0};
+    s.normal.x = nx; s.normal.y = ny; s.normal.z = nz; s.offset = offset;
+    return s;
+}
+
+typedef struct carom_body_def {
+    uint32_t size;                 /* sizeof(carom_body_def), stamped by the default */
+    carom_body_type type;          /* DYNAMIC */
+    carom_vec3 position;           /* body origin, world frame */
+    carom_quat orientation;        /* identity; must be unit (|q| within 1e-6 of 1) */
+    carom_vec3 linear_velocity;    /* of the centre of mass */
+    carom_vec3 angular_velocity;   /* world frame */
+    carom_shape_def shape;         /* sphere of radius 0.5 */
+    double mass;                   /* > 0: total mass (wins over density); 0: use density */
+    double density;                /* 1000 kg/m^3 */
+    double friction;               /* 0.6 (Coulomb mu, >= 0) */
+    double restitution;            /* 0 (0..1) */
+    double linear_damping;         /* 0 (1/s) */
+    double angular_damping;        /* 0 (1/s) */
+    double gravity_scale;          /* 1 */
+    int lock_rotation;             /* 0: 1 makes the body a particle (never rotates) */
+    int lock_to_plane;             /* 0: 1 keeps the body in the plane through its start
+                                      position with normal plane_normal (2D) */
+    carom_vec3 plane_normal;       /* (0, 1, 0): the x-z plane */
+    int bullet;                    /* 0: 1 = continuous collision against dynamic bodies too */
+    int enable_sleep;              /* 1 */
+    int awake;                     /* 1 */
+    void *user_data;               /* NULL */
+} carom_body_def;
+
+static inline carom_body_def carom_body_def_default(void)
+{
+    carom_body_def d;
+    d.size = (uint32_t)sizeof(carom_body_def);
+    d.type = CAROM_BODY_DYNAMIC;
+    d.position.x = 0; d.position.y = 0; d.position.z = 0;
+    d.orientation.w = 1; d.orientation.x = 0; d.orientation.y = 0; d.orientation.z = 0;
+    d.linear_velocity.x = 0; d.linear_velocity.y = 0; d.linear_velocity.z = 0;
+    d.angular_velocity.x = 0; d.angular_velocity.y = 0; d.angular_velocity.z = 0;
+    d.shape = carom_shape_sphere(0.5);
+    d.mass = 0;
+    d.density = 1000.0;
+    d.friction = 0.6;
+    d.restitution = 0.0;
+    d.linear_damping = 0.0;
+    d.angular_damping = 0.0;
+    d.gravity_scale = 1.0;
+    d.lock_rotation = 0;
+    d.lock_to_plane = 0;
+    d.plane_normal.x = 0; d.plane_normal.y = 1; d.plane_normal.z = 0;
+    d.bullet = 0;
+    d.enable_sleep = 1;
+    d.awake = 1;
+    d.user_data = 0;
+    return d;
+}
+
+/* Returns the null id on failure (carom_world_last_error says why); the world
+ * is then unchanged. */
+CAROM_API carom_body_id carom_body_create(carom_world *world, const carom_body_def *def);
+/* Inside an event callback the destroy is deferred to the end of the step. */
+CAROM_API carom_status carom_body_destroy(carom_world *world, carom_body_id id);
+CAROM_API int carom_body_is_valid(const carom_world *world, carom_body_id id);
+
+CAROM_API carom_status carom_body_get_type(const carom_world *world, carom_body_id id, carom_body_type *out);
+CAROM_API carom_status carom_body_set_type(carom_world *world, carom_body_id id, carom_body_type type);
+CAROM_API carom_status carom_body_get_shape_type(const carom_world *world, carom_body_id id, carom_shape_type *out);
+/* Position of the body origin; orientation (w, x, y, z). */
+CAROM_API carom_status carom_body_get_position(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_set_position(carom_world *world, carom_body_id id, carom_vec3 position);
+CAROM_API carom_status carom_body_get_orientation(const carom_world *world, carom_body_id id, carom_quat *out);
+CAROM_API carom_status carom_body_set_orientation(carom_world *world, carom_body_id id, carom_quat q);
+/* World position of the centre of mass. */
+CAROM_API carom_status carom_body_get_center_of_mass(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_get_linear_velocity(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_set_linear_velocity(carom_world *world, carom_body_id id, carom_vec3 v);
+CAROM_API carom_status carom_body_get_angular_velocity(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_set_angular_velocity(carom_world *world, carom_body_id id, carom_vec3 w);
+/* Mass (0 for static and kinematic bodies). */
+CAROM_API carom_status carom_body_get_mass(const carom_world *world, carom_body_id id, double *out);
+/* Rescales the body's mass properties to a new mass > 0 (dynamic bodies). */
+CAROM_API carom_status carom_body_set_mass(carom_world *world, carom_body_id id, double mass);
+/* Inertia tensor about the centre of mass, body axes, row major 3x3. */
+CAROM_API carom_status carom_body_get_inertia(const carom_world *world, carom_body_id id, double out[9]);
+/* Centre of mass in the body frame. */
+CAROM_API carom_status carom_body_get_local_center(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_get_friction(const carom_world *world, carom_body_id id, double *out);
+CAROM_API carom_status carom_body_set_friction(carom_world *world, carom_body_id id, double friction);
+CAROM_API carom_status carom_body_get_restitution(const carom_world *world, carom_body_id id, double *out);
+CAROM_API carom_status carom_body_set_restitution(carom_world *world, carom_body_id id, double restitution);
+CAROM_API carom_status carom_body_set_gravity_scale(carom_world *world, carom_body_id id, double scale);
+CAROM_API carom_status carom_body_set_bullet(carom_world *world, carom_body_id id, int bullet);
+CAROM_API void *carom_body_get_user_data(const carom_world *world, carom_body_id id);
+CAROM_API carom_status carom_body_set_user_data(carom_world *world, carom_body_id id, void *user_data);
+/* Applies impulse j (N s) at world point p (the centre of mass when p is NULL). Wakes the body. */
+CAROM_API carom_status carom_body_apply_impulse(carom_world *world, carom_body_id id, carom_vec3 j,
+                                                const carom_vec3 *point);
+/* Adds a force (N) at the centre of mass for the next step only. */
+CAROM_API carom_status carom_body_apply_force(carom_world *world, carom_body_id id, carom_vec3 force);
+CAROM_API int carom_body_is_awake(const carom_world *world, carom_body_id id);
+CAROM_API carom_status carom_body_set_awake(carom_world *world, carom_body_id id, int awake);
+/* Kinetic energy (linear + rotational) of one body. */
+CAROM_API carom_status carom_body_get_kinetic_energy(const carom_world *world, carom_body_id id, double *out);
+
+/* ---- events, probes, queries ------------------------------------------- */
+
+typedef enum carom_event_type {
+    CAROM_EVENT_BEGIN = 0,   /* two bodies started touching */
+    CAROM_EVENT_END = 1,     /* they stopped touching */
+    CAROM_EVENT_HIT = 2      /* an impact: approach speed above the restitution threshold */
+} carom_event_type;
+
+struct carom_contact_event {
+    carom_event_type type;
+    carom_body_id a, b;
+    carom_vec3 point;             /* world contact point (hit and begin) */
+    carom_vec3 normal;            /* unit, from a to b */
+    double normal_impulse;        /* N s over the step (hit; begin: the impulse so far) */
+    double tangent_impulse;       /* magnitude of the friction impulse (N s) */
+    double approach_speed;        /* relative normal speed before the impact (m/s, > 0) */
+    double average_force;         /* normal_impulse / dt (N) */
+};
+
+/* Events of the last step, valid until the next step or world destroy. */
+CAROM_API int carom_world_get_events(const carom_world *world, const carom_contact_event **events);
+
+typedef struct carom_world_stats {
+    uint32_t size;                /* sizeof(carom_world_stats) */
+    int bodies;
+    int awake_bodies;
+    int islands;
+    int pairs;                    /* broadphase pairs (fat AABBs overlap) */
+    int contacts;                 /* touching manifolds */
+    int contact_points;
+    double max_penetration;       /* deepest overlap after the last step (m) */
+    int clamped;                  /* velocities clamped in the last step (speed limit) */
+    int toi_events;               /* time-of-impact sub-steps taken */
+    int non_finite;               /* bodies whose state went non-finite and were reset */
+    double ms_broadphase, ms_narrowphase, ms_solver, ms_continuous, ms_islands, ms_total;
+    long long step_count;
+} carom_world_stats;
+
+static inline carom_world_stats carom_world_stats_init(void)
+{
+    carom_world_stats s;
+    s.size = (uint32_t)sizeof(carom_world_stats);
+    s.bodies = s.awake_bodies = s.islands = s.pairs = s.contacts = s.contact_points = 0;
+    s.max_penetration = 0;
+    s.clamped = s.toi_events = s.non_finite = 0;
+    s.ms_broadphase = s.ms_narrowphase = s.ms_solver = s.ms_continuous = s.ms_islands = s.ms_total = 0;
+    s.step_count = 0;
+    return s;
+}
+/* stats->size must be set (carom_world_stats_init does it). */
+CAROM_API carom_status carom_world_get_stats(const carom_world *world, carom_world_stats *stats);
+/* Total kinetic energy and gravitational potential energy (relative to z = 0
+ * along gravity: -m g.x) of the dynamic bodies. */
+CAROM_API carom_status carom_world_get_energy(const carom_world *world, double *kinetic, double *potential);
+/* Linear momentum and angular momentum about the world origin of the dynamic bodies. */
+CAROM_API carom_status carom_world_get_momentum(const carom_world *world, carom_vec3 *linear, carom_vec3 *angular);
+
+typedef struct carom_ray_hit {
+    carom_body_id body;
+    carom_vec3 point;
+    carom_vec3 normal;
+    double fraction;              /* along the translation, 0..1 */
+} carom_ray_hit;
+
+/* Closest hit of the segment origin -> origin + translation. Returns 1 on a hit,
+ * 0 on none, -1 on bad input. */
+CAROM_API int carom_world_ray_cast(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
+                                   carom_ray_hit *hit);
+/* Bodies whose bounds overlap the box [lo, hi]: fills up to capacity ids and
+ * returns the total count (so a second call can size the array); -1 on bad input. */
+CAROM_API int carom_world_query_aabb(const carom_world *world, carom_vec3 lo, carom_vec3 hi,
+                                     carom_body_id *ids, int capacity);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,620 @@
+/* body_api.c - the public body functions: validated create/destroy, getters
+ * and setters. Every entry checks its input and leaves the world unchanged
+ * on error. */
+#include <stdlib.h>
+#include <string.h>
+#include "world.h"
+
+#define AABB_MARGIN 0.1   /* fat AABB margin (m): bodies move this far before re-insertion */
+#define MAX_COORDINATE 1e12
+
+static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
+static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
+static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+static int quat_ok(carom_quat q)
+{
+    double l2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
+    return isfinite(l2) && fabs(sqrt(l2) - 1.0) <= 1e-6;
+}
+
+carom_body_id world_make_id(const carom_world *w, int id_index)
+{
+    carom_body_id id = {(uint32_t)id_index + 1, w->bodies.ids[id_index].generation};
+    return id;
+}
+
+CAROM_API int carom_body_is_valid(const carom_world *w, carom_body_id id)
+{
+    return w && body_store_slot(&w->bodies, id.index1, id.generation) >= 0;
+}
+
+/* Slot of id, or -1 with the world's error set (fn names the caller). */
+static int lookup(const carom_world *w, carom_body_id id, const char *fn)
+{
+    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
+    if (slot < 0) world_fail(w, CAROM_ERROR_STALE_ID, "%s: body has been destroyed (or the id is invalid)", fn);
+    return slot;
+}
+
+#define GET_SLOT(w, id, fn)                                                        \
+    if (!(w)) return CAROM_ERROR_INVALID_ARGUMENT;                                 \
+    int slot = lookup((w), (id), (fn));                                            \
+    if (slot < 0) return CAROM_ERROR_STALE_ID;
+#define REQUIRE_UNLOCKED(w, fn)                                                    \
+    if ((w)->locked) return world_fail((w), CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", (fn));
+#define REQUIRE_OUT(p, fn)                                                         \
+    if (!(p)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: output pointer is NULL", (fn));
+
+aabb world_body_fat_aabb(const carom_world *w, int slot, double margin)
+{
+    aabb box = shape_aabb(&w->bodies.shapes[slot], body_xform(&w->bodies, slot));
+    return aabb_fatten(box, margin + w->def.speculative_distance);
+}
+
+void world_wake_body(carom_world *w, int slot)
+{
+    body_store *s = &w->bodies;
+    if (s->type[slot] == CAROM_BODY_STATIC) return;
+    s->flags[slot] |= BODY_AWAKE;
+    s->sleep_time[slot] = 0;
+}
+
+void world_remove_body_contacts(carom_world *w, int id_index)
+{
+    contact_set *cs = &w->contacts;
+    for (int i = cs->count - 1; i >= 0; i--)
+        if (cs->items[i].id_a == id_index || cs->items[i].id_b == id_index) {
+            /* wake the other body: what rested on this one must fall */
+            int other = cs->items[i].id_a == id_index ? cs->items[i].id_b : cs->items[i].id_a;
+            int oslot = w->bodies.ids[other].slot;
+            if (oslot >= 0) world_wake_body(w, oslot);
+            contact_remove(cs, i);
+        }
+}
+
+static void refresh_proxy(carom_world *w, int slot)
+{
+    aabb fat = world_body_fat_aabb(w, slot, AABB_MARGIN);
+    w->bodies.fat_box[slot] = fat;
+    bp_move_proxy(w->bp, w->bodies.proxy[slot], fat);
+}
+
+/* ---- validation of a body def ------------------------------------------------ */
+
+static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_type type)
+{
+    switch (sd->type) {
+    case CAROM_SHAPE_SPHERE:
+        if (!(isfinite(sd->radius) && sd->radius > 0))
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: sphere radius must be positive and finite (got %g)", sd->radius), 0;
+        break;
+    case CAROM_SHAPE_BOX:
+        if (!(finite_c(sd->half_extents) && sd->half_extents.x > 0 && sd->half_extents.y > 0 && sd->half_extents.z > 0))
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: box half extents must be positive and finite"), 0;
+        break;
+    case CAROM_SHAPE_CAPSULE:
+    case CAROM_SHAPE_CYLINDER:
+        if (!(isfinite(sd->radius) && sd->radius > 0 && isfinite(sd->half_height) && sd->half_height > 0))
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s radius and half_height must be positive and finite",
+                              sd->type == CAROM_SHAPE_CAPSULE ? "capsule" : "cylinder"), 0;
+        break;
+    case CAROM_SHAPE_HULL:
+        if (!sd->points || sd->point_count < 4 || sd->point_count > 100000)
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a hull needs 4..100000 points (got %d%s)",
+                              sd->point_count, sd->points ? "" : ", NULL array"), 0;
+        break;
+    case CAROM_SHAPE_PLANE:
+        if (type != CAROM_BODY_STATIC)
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a plane can only be a static body"), 0;
+        if (!finite_c(sd->normal) || !isfinite(sd->offset) || v3_len(to_v3(sd->normal)) < 1e-12)
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: plane normal must be finite and non-zero, offset finite"), 0;
+        break;
+    default:
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: unknown shape type %d", (int)sd->type), 0;
+    }
+    return 1;
+}
+
+static int check_body_def(carom_world *w, const carom_body_def *d)
+{
+#define FAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
+    if (d->type != CAROM_BODY_STATIC && d->type != CAROM_BODY_KINEMATIC && d->type != CAROM_BODY_DYNAMIC)
+        FAIL("body_create: unknown body type %d", (int)d->type);
+    if (!finite_c(d->position)) FAIL("body_create: position must be finite");
+    if (fabs(d->position.x) > MAX_COORDINATE || fabs(d->position.y) > MAX_COORDINATE || fabs(d->position.z) > MAX_COORDINATE)
+        FAIL("body_create: position beyond 1e12 m");
+    if (!quat_ok(d->orientation)) FAIL("body_create: orientation must be a finite unit quaternion {w,x,y,z}");
+    if (!finite_c(d->linear_velocity)) FAIL("body_create: linear velocity must be finite");
+    if (!finite_c(d->angular_velocity)) FAIL("body_create: angular velocity must be finite");
+    if (!(isfinite(d->mass) && d->mass >= 0)) FAIL("body_create: mass must be finite and >= 0 (got %g)", d->mass);
+    if (!(isfinite(d->density) && d->density >= 0)) FAIL("body_create: density must be finite and >= 0 (got %g)", d->density);
+    if (d->type == CAROM_BODY_DYNAMIC && d->mass == 0 && d->density == 0)
+        FAIL("body_create: a dynamic body needs mass > 0 or density > 0");
+    if (!(isfinite(d->friction) && d->friction >= 0)) FAIL("body_create: friction must be finite and >= 0");
+    if (!(isfinite(d->restitution) && d->restitution >= 0 && d->restitution <= 1))
+        FAIL("body_create: restitution must be in [0, 1]");
+    if (!(isfinite(d->linear_damping) && d->linear_damping >= 0)) FAIL("body_create: linear damping must be finite and >= 0");
+    if (!(isfinite(d->angular_damping) && d->angular_damping >= 0)) FAIL("body_create: angular damping must be finite and >= 0");
+    if (!isfinite(d->gravity_scale)) FAIL("body_create: gravity scale must be finite");
+    if (d->lock_to_plane && (!finite_c(d->plane_normal) || v3_len(to_v3(d->plane_normal)) < 1e-12))
+        FAIL("body_create: plane_normal must be finite and non-zero");
+#undef FAIL
+    return check_shape(w, &d->shape, d->type);
+}
+
+static void build_shape(const carom_shape_def *sd, shape *s)
+{
+    memset(s, 0, sizeof *s);
+    s->type = (int)sd->type;
+    s->radius = sd->radius;
+    s->half_height = sd->half_height;
+    s->half_extents = to_v3(sd->half_extents);
+    if (sd->type == CAROM_SHAPE_PLANE) {
+        double len = v3_len(to_v3(sd->normal));
+        s->plane_normal = v3_scale(to_v3(sd->normal), 1.0 / len);
+        s->plane_offset = sd->offset / len;
+    }
+}
+
+CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *user_def)
+{
+    carom_body_id null_id = carom_null_body();
+    if (!w) return null_id;
+    if (w->locked) {
+        world_fail(w, CAROM_ERROR_LOCKED, "body_create: cannot create bodies inside step or a callback");
+        return null_id;
+    }
+    if (!user_def) { world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: def is NULL"); return null_id; }
+    if (user_def->size < offsetof(carom_body_def, shape) + sizeof(carom_shape_def)) {
+        world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: def size %u too small: use carom_body_def_default()",
+                   (unsigned)user_def->size);
+        return null_id;
+    }
+    carom_body_def d = carom_body_def_default();
+    memcpy(&d, user_def, user_def->size < sizeof d ? user_def->size : sizeof d);
+    if (!check_body_def(w, &d)) return null_id;
+
+    shape sh;
+    build_shape(&d.shape, &sh);
+    if (d.shape.type == CAROM_SHAPE_HULL) {
+        char err[160];
+        sh.hull = hull_build(d.shape.points, d.shape.point_count, err, (int)sizeof err);
+        if (!sh.hull) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: bad hull: %s", err);
+            return null_id;
+        }
+    }
+    mass_props mp = {0, {0, 0, 0}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
+    if (sh.type != SHAPE_PLANE)
+        mp = d.mass > 0 ? shape_mass_from_mass(&sh, d.mass) : shape_mass_from_density(&sh, d.density);
+    if (d.type == CAROM_BODY_DYNAMIC && !(mp.mass > 0 && isfinite(mp.mass))) {
+        hull_free(sh.hull);
+        world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: dynamic body mass is not positive (got %g)", mp.mass);
+        return null_id;
+    }
+    if (!body_store_reserve(&w->bodies)) {
+        hull_free(sh.hull);
+        world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
+        return null_id;
+    }
+
+    body_store *s = &w->bodies;
+    int id_index;
+    int slot = body_store_add(s, &id_index);
+    quat q = q_normalize((quat){d.orientation.w, d.orientation.x, d.orientation.y, d.orientation.z});
+    int dynamic = d.type == CAROM_BODY_DYNAMIC;
+    s->type[slot] = (int)d.type;
+    s->flags[slot] = (d.lock_rotation ? BODY_LOCK_ROTATION : 0) | (d.lock_to_plane ? BODY_LOCK_PLANE : 0) |
+                     (d.bullet ? BODY_BULLET : 0) | (d.enable_sleep ? BODY_ENABLE_SLEEP : 0) |
+                     ((d.awake || !d.enable_sleep) && d.type != CAROM_BODY_STATIC ? BODY_AWAKE : 0);
+    s->rotation[slot] = q;
+    s->local_center[slot] = mp.center;
+    s->center[slot] = v3_add(to_v3(d.position), q_rotate(q, mp.center));
+    s->velocity[slot] = d.type == CAROM_BODY_STATIC ? v3_zero() : to_v3(d.linear_velocity);
+    s->angular_velocity[slot] = d.type == CAROM_BODY_STATIC || d.lock_rotation ? v3_zero() : to_v3(d.angular_velocity);
+    s->force[slot] = v3_zero();
+    s->mass[slot] = mp.mass;
+    s->inv_mass[slot] = dynamic ? 1.0 / mp.mass : 0.0;
+    s->inertia_local[slot] = mp.inertia;
+    s->inv_inertia_local[slot] = dynamic ? m3_inverse(mp.inertia) : m3_zero();
+    s->friction[slot] = d.friction;
+    s->restitution[slot] = d.restitution;
+    s->linear_damping[slot] = d.linear_damping;
+    s->angular_damping[slot] = d.angular_damping;
+    s->gravity_scale[slot] = d.gravity_scale;
+    s->plane_normal[slot] = v3_normalize(to_v3(d.plane_normal));
+    s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
+    s->sleep_time[slot] = 0;
+    s->shapes[slot] = sh;
+    s->user_data[slot] = d.user_data;
+    s->solver_index[slot] = -1;
+    if (d.lock_to_plane) {
+        /* keep only in-plane motion: velocity in the plane, spin about its normal */
+        vec3 n = s->plane_normal[slot];
+        s->velocity[slot] = v3_madd(s->velocity[slot], -v3_dot(s->velocity[slot], n), n);
+        s->angular_velocity[slot] = v3_scale(n, v3_dot(s->angular_velocity[slot], n));
+    }
+    body_update_inertia(s, slot);
+    aabb fat = world_body_fat_aabb(w, slot, AABB_MARGIN);
+    s->fat_box[slot] = fat;
+    s->proxy[slot] = bp_create_proxy(w->bp, fat, d.type == CAROM_BODY_STATIC, id_index);
+    if (s->proxy[slot] < 0) {
+        body_store_remove(s, slot);
+        hull_free(sh.hull);
+        world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory (broadphase)");
+        return null_id;
+    }
+    return world_make_id(w, id_index);
+}
+
+CAROM_API carom_status carom_body_destroy(carom_world *w, carom_body_id id)
+{
+    GET_SLOT(w, id, "body_destroy");
+    if (w->in_callback) {
+        step_scratch *sc = &w->scratch;
+        for (int i = 0; i < sc->deferred_count; i++)
+            if (sc->deferred_destroy[i] == (int)id.index1 - 1) return CAROM_OK;
+        if (sc->deferred_count >= sc->deferred_capacity) {
+            int cap = sc->deferred_capacity ? sc->deferred_capacity * 2 : 16;
+            int *n = realloc(sc->deferred_destroy, sizeof *n * (size_t)cap);
+            if (!n) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_destroy: out of memory");
+            sc->deferred_destroy = n;
+            sc->deferred_capacity = cap;
+        }
+        sc->deferred_destroy[sc->deferred_count++] = (int)id.index1 - 1;
+        return CAROM_OK;
+    }
+    REQUIRE_UNLOCKED(w, "body_destroy");
+    world_remove_body_contacts(w, (int)id.index1 - 1);
+    bp_destroy_proxy(w->bp, w->bodies.proxy[slot]);
+    hull_free(w->bodies.shapes[slot].hull);
+    body_store_remove(&w->bodies, slot);
+    return CAROM_OK;
+}
+
+/* ---- getters --------------------------------------------------------------- */
+
+CAROM_API carom_status carom_body_get_type(const carom_world *w, carom_body_id id, carom_body_type *out)
+{
+    GET_SLOT(w, id, "body_get_type");
+    REQUIRE_OUT(out, "body_get_type");
+    *out = (carom_body_type)w->bodies.type[slot];
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_shape_type(const carom_world *w, carom_body_id id, carom_shape_type *out)
+{
+    GET_SLOT(w, id, "body_get_shape_type");
+    REQUIRE_OUT(out, "body_get_shape_type");
+    *out = (carom_shape_type)w->bodies.shapes[slot].type;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_position(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    GET_SLOT(w, id, "body_get_position");
+    REQUIRE_OUT(out, "body_get_position");
+    *out = from_v3(body_origin(&w->bodies, slot));
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_orientation(const carom_world *w, carom_body_id id, carom_quat *out)
+{
+    GET_SLOT(w, id, "body_get_orientation");
+    REQUIRE_OUT(out, "body_get_orientation");
+    quat q = w->bodies.rotation[slot];
+    out->w = q.w; out->x = q.x; out->y = q.y; out->z = q.z;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_center_of_mass(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    GET_SLOT(w, id, "body_get_center_of_mass");
+    REQUIRE_OUT(out, "body_get_center_of_mass");
+    *out = from_v3(w->bodies.center[slot]);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_linear_velocity(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    GET_SLOT(w, id, "body_get_linear_velocity");
+    REQUIRE_OUT(out, "body_get_linear_velocity");
+    *out = from_v3(w->bodies.velocity[slot]);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_angular_velocity(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    GET_SLOT(w, id, "body_get_angular_velocity");
+    REQUIRE_OUT(out, "body_get_angular_velocity");
+    *out = from_v3(w->bodies.angular_velocity[slot]);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_mass(const carom_world *w, carom_body_id id, double *out)
+{
+    GET_SLOT(w, id, "body_get_mass");
+    REQUIRE_OUT(out, "body_get_mass");
+    *out = w->bodies.type[slot] == CAROM_BODY_DYNAMIC ? w->bodies.mass[slot] : 0.0;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_inertia(const carom_world *w, carom_body_id id, double out[9])
+{
+    GET_SLOT(w, id, "body_get_inertia");
+    REQUIRE_OUT(out, "body_get_inertia");
+    mat3 m = w->bodies.inertia_local[slot];
+    vec3 c[3] = {m.c0, m.c1, m.c2};
+    for (int col = 0; col < 3; col++) {
+        out[0 * 3 + col] = c[col].x;
+        out[1 * 3 + col] = c[col].y;
+        out[2 * 3 + col] = c[col].z;
+    }
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_local_center(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    GET_SLOT(w, id, "body_get_local_center");
+    REQUIRE_OUT(out, "body_get_local_center");
+    *out = from_v3(w->bodies.local_center[slot]);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_friction(const carom_world *w, carom_body_id id, double *out)
+{
+    GET_SLOT(w, id, "body_get_friction");
+    REQUIRE_OUT(out, "body_get_friction");
+    *out = w->bodies.friction[slot];
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_restitution(const carom_world *w, carom_body_id id, double *out)
+{
+    GET_SLOT(w, id, "body_get_restitution");
+    REQUIRE_OUT(out, "body_get_restitution");
+    *out = w->bodies.restitution[slot];
+    return CAROM_OK;
+}
+
+CAROM_API void *carom_body_get_user_data(const carom_world *w, carom_body_id id)
+{
+    if (!w) return NULL;
+    int slot = lookup(w, id, "body_get_user_data");
+    return slot < 0 ? NULL : w->bodies.user_data[slot];
+}
+
+CAROM_API int carom_body_is_awake(const carom_world *w, carom_body_id id)
+{
+    if (!w) return 0;
+    int slot = lookup(w, id, "body_is_awake");
+    return slot >= 0 && (w->bodies.flags[slot] & BODY_AWAKE) != 0;
+}
+
+CAROM_API carom_status carom_body_get_kinetic_energy(const carom_world *w, carom_body_id id, double *out)
+{
+    GET_SLOT(w, id, "body_get_kinetic_energy");
+    REQUIRE_OUT(out, "body_get_kinetic_energy");
+    const body_store *s = &w->bodies;
+    if (s->type[slot] != CAROM_BODY_DYNAMIC) { *out = 0; return CAROM_OK; }
+    mat3 r = m3_from_quat(s->rotation[slot]);
+    *out = kinetic_energy(s->mass[slot], m3_rotate_tensor(r, s->inertia_local[slot]), s->velocity[slot],
+                          s->angular_velocity[slot]);
+    return CAROM_OK;
+}
+
+/* ---- setters --------------------------------------------------------------- */
+
+CAROM_API carom_status carom_body_set_position(carom_world *w, carom_body_id id, carom_vec3 p)
+{
+    GET_SLOT(w, id, "body_set_position");
+    REQUIRE_UNLOCKED(w, "body_set_position");
+    if (!finite_c(p) || fabs(p.x) > MAX_COORDINATE || fabs(p.y) > MAX_COORDINATE || fabs(p.z) > MAX_COORDINATE)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_position: position must be finite (|x| <= 1e12)");
+    body_store *s = &w->bodies;
+    s->center[slot] = v3_add(to_v3(p), q_rotate(s->rotation[slot], s->local_center[slot]));
+    if (s->flags[slot] & BODY_LOCK_PLANE) s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
+    refresh_proxy(w, slot);
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_orientation(carom_world *w, carom_body_id id, carom_quat q)
+{
+    GET_SLOT(w, id, "body_set_orientation");
+    REQUIRE_UNLOCKED(w, "body_set_orientation");
+    if (!quat_ok(q)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_orientation: need a finite unit quaternion");
+    body_store *s = &w->bodies;
+    vec3 origin = body_origin(s, slot);
+    s->rotation[slot] = q_normalize((quat){q.w, q.x, q.y, q.z});
+    s->center[slot] = v3_add(origin, q_rotate(s->rotation[slot], s->local_center[slot]));
+    body_update_inertia(s, slot);
+    refresh_proxy(w, slot);
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_linear_velocity(carom_world *w, carom_body_id id, carom_vec3 v)
+{
+    GET_SLOT(w, id, "body_set_linear_velocity");
+    REQUIRE_UNLOCKED(w, "body_set_linear_velocity");
+    if (!finite_c(v)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_linear_velocity: velocity must be finite");
+    body_store *s = &w->bodies;
+    if (s->type[slot] == CAROM_BODY_STATIC)
+        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_linear_velocity: a static body cannot move");
+    vec3 nv = to_v3(v);
+    if (s->flags[slot] & BODY_LOCK_PLANE) nv = v3_madd(nv, -v3_dot(nv, s->plane_normal[slot]), s->plane_normal[slot]);
+    s->velocity[slot] = nv;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_body_id id, carom_vec3 av)
+{
+    GET_SLOT(w, id, "body_set_angular_velocity");
+    REQUIRE_UNLOCKED(w, "body_set_angular_velocity");
+    if (!finite_c(av)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_angular_velocity: must be finite");
+    body_store *s = &w->bodies;
+    if (s->type[slot] == CAROM_BODY_STATIC)
+        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_angular_velocity: a static body cannot move");
+    vec3 nw = to_v3(av);
+    if (s->flags[slot] & BODY_LOCK_ROTATION) nw = v3_zero();
+    if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
+    s->angular_velocity[slot] = nw;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_mass(carom_world *w, carom_body_id id, double mass)
+{
+    GET_SLOT(w, id, "body_set_mass");
+    REQUIRE_UNLOCKED(w, "body_set_mass");
+    body_store *s = &w->bodies;
+    if (!(isfinite(mass) && mass > 0)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_mass: mass must be positive and finite (got %g)", mass);
+    if (s->type[slot] != CAROM_BODY_DYNAMIC)
+        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_mass: only dynamic bodies have mass");
+    mass_props mp = shape_mass_from_mass(&s->shapes[slot], mass);
+    vec3 origin = body_origin(s, slot);
+    s->mass[slot] = mp.mass;
+    s->inv_mass[slot] = 1.0 / mp.mass;
+    s->local_center[slot] = mp.center;
+    s->center[slot] = v3_add(origin, q_rotate(s->rotation[slot], mp.center));
+    s->inertia_local[slot] = mp.inertia;
+    s->inv_inertia_local[slot] = m3_inverse(mp.inertia);
+    body_update_inertia(s, slot);
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_type(carom_world *w, carom_body_id id, carom_body_type type)
+{
+    GET_SLOT(w, id, "body_set_type");
+    REQUIRE_UNLOCKED(w, "body_set_type");
+    body_store *s = &w->bodies;
+    if (type != CAROM_BODY_STATIC && type != CAROM_BODY_KINEMATIC && type != CAROM_BODY_DYNAMIC)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: unknown type %d", (int)type);
+    if (s->type[slot] == (int)type) return CAROM_OK;
+    if (s->shapes[slot].type == SHAPE_PLANE)
+        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a plane must stay static");
+    if (type == CAROM_BODY_DYNAMIC && !(s->mass[slot] > 0))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: body has no mass");
+    int proxy = bp_create_proxy(w->bp, s->fat_box[slot], type == CAROM_BODY_STATIC, s->id_index[slot]);
+    if (proxy < 0) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_set_type: out of memory");
+    bp_destroy_proxy(w->bp, s->proxy[slot]);
+    s->proxy[slot] = proxy;
+    world_remove_body_contacts(w, s->id_index[slot]);
+    s->type[slot] = (int)type;
+    int dynamic = type == CAROM_BODY_DYNAMIC;
+    s->inv_mass[slot] = dynamic ? 1.0 / s->mass[slot] : 0.0;
+    s->inv_inertia_local[slot] = dynamic ? m3_inverse(s->inertia_local[slot]) : m3_zero();
+    if (type == CAROM_BODY_STATIC) {
+        s->velocity[slot] = v3_zero();
+        s->angular_velocity[slot] = v3_zero();
+        s->flags[slot] &= ~(uint32_t)BODY_AWAKE;
+    } else {
+        world_wake_body(w, slot);
+    }
+    body_update_inertia(s, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_friction(carom_world *w, carom_body_id id, double friction)
+{
+    GET_SLOT(w, id, "body_set_friction");
+    REQUIRE_UNLOCKED(w, "body_set_friction");
+    if (!(isfinite(friction) && friction >= 0))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_friction: friction must be finite and >= 0");
+    w->bodies.friction[slot] = friction;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_restitution(carom_world *w, carom_body_id id, double restitution)
+{
+    GET_SLOT(w, id, "body_set_restitution");
+    REQUIRE_UNLOCKED(w, "body_set_restitution");
+    if (!(isfinite(restitution) && restitution >= 0 && restitution <= 1))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_restitution: restitution must be in [0, 1]");
+    w->bodies.restitution[slot] = restitution;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_gravity_scale(carom_world *w, carom_body_id id, double scale)
+{
+    GET_SLOT(w, id, "body_set_gravity_scale");
+    REQUIRE_UNLOCKED(w, "body_set_gravity_scale");
+    if (!isfinite(scale)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_gravity_scale: must be finite");
+    w->bodies.gravity_scale[slot] = scale;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_bullet(carom_world *w, carom_body_id id, int bullet)
+{
+    GET_SLOT(w, id, "body_set_bullet");
+    REQUIRE_UNLOCKED(w, "body_set_bullet");
+    if (bullet) w->bodies.flags[slot] |= BODY_BULLET;
+    else w->bodies.flags[slot] &= ~(uint32_t)BODY_BULLET;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_user_data(carom_world *w, carom_body_id id, void *user_data)
+{
+    GET_SLOT(w, id, "body_set_user_data");
+    w->bodies.user_data[slot] = user_data;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_awake(carom_world *w, carom_body_id id, int awake)
+{
+    GET_SLOT(w, id, "body_set_awake");
+    REQUIRE_UNLOCKED(w, "body_set_awake");
+    body_store *s = &w->bodies;
+    if (s->type[slot] == CAROM_BODY_STATIC) return CAROM_OK;
+    if (awake) world_wake_body(w, slot);
+    else if (s->flags[slot] & BODY_ENABLE_SLEEP) {
+        s->flags[slot] &= ~(uint32_t)BODY_AWAKE;
+        s->sleep_time[slot] = w->def.sleep_time;
+        s->velocity[slot] = v3_zero();
+        s->angular_velocity[slot] = v3_zero();
+    }
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id, carom_vec3 j, const carom_vec3 *point)
+{
+    GET_SLOT(w, id, "body_apply_impulse");
+    REQUIRE_UNLOCKED(w, "body_apply_impulse");
+    if (!finite_c(j)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: impulse must be finite");
+    if (point && !finite_c(*point)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: point must be finite");
+    body_store *s = &w->bodies;
+    if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK; /* infinite mass: no effect */
+    vec3 jv = to_v3(j);
+    vec3 dv = v3_scale(jv, s->inv_mass[slot]);
+    vec3 dw = v3_zero();
+    if (point) dw = m3_mulv(s->inv_inertia_world[slot], v3_cross(v3_sub(to_v3(*point), s->center[slot]), jv));
+    vec3 nv = v3_add(s->velocity[slot], dv), nw = v3_add(s->angular_velocity[slot], dw);
+    if (s->flags[slot] & BODY_LOCK_PLANE) {
+        vec3 n = s->plane_normal[slot];
+        nv = v3_madd(nv, -v3_dot(nv, n), n);
+        nw = v3_scale(n, v3_dot(nw, n));
+    }
+    if (!v3_is_finite(nv) || !v3_is_finite(nw))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: resulting velocity is not finite");
+    s->velocity[slot] = nv;
+    s->angular_velocity[slot] = nw;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_apply_force(carom_world *w, carom_body_id id, carom_vec3 force)
+{
+    GET_SLOT(w, id, "body_apply_force");
+    REQUIRE_UNLOCKED(w, "body_apply_force");
+    if (!finite_c(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_force: force must be finite");
+    body_store *s = &w->bodies;
+    if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK;
+    s->force[slot] = v3_add(s->force[slot], to_v3(force));
+    s->flags[slot] |= BODY_HAS_FORCE;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}

@@ -1,0 +1,35 @@
+/* broadphase.h - dynamic AABB trees over fattened bounds; static and moving
+ * proxies in separate trees so static geometry costs nothing per step. */
+#ifndef CAROM_BROADPHASE_H
+#define CAROM_BROADPHASE_H
+
+#include "vecmath.h"
+
+typedef struct broadphase broadphase;
+
+/* Called for each overlapping pair found; user values as given at creation. */
+typedef void bp_pair_fn(void *ctx, int user_a, int user_b);
+/* Return 0 to stop the query. */
+typedef int bp_query_fn(void *ctx, int user);
+/* Return the new max fraction (clip), or < 0 to stop; max_t to continue unchanged. */
+typedef double bp_ray_fn(void *ctx, int user, vec3 origin, vec3 dir, double max_t);
+
+broadphase *bp_create(void);
+void bp_destroy(broadphase *bp);
+/* Returns the proxy id (>= 0) or -1 when out of memory. The box is stored as given
+ * (the caller fattens it). A new proxy counts as moved. */
+int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user);
+void bp_destroy_proxy(broadphase *bp, int proxy);
+/* Replaces the proxy's box and marks it moved. */
+void bp_move_proxy(broadphase *bp, int proxy, aabb box);
+aabb bp_get_aabb(const broadphase *bp, int proxy);
+int bp_get_user(const broadphase *bp, int proxy);
+/* Reports every pair of overlapping boxes where at least one was moved (or
+ * created) since the last call, then clears the moved set. Static-static
+ * pairs are never reported. A pair is reported at most once per call. */
+void bp_update_pairs(broadphase *bp, bp_pair_fn *fn, void *ctx);
+void bp_query(const broadphase *bp, aabb box, bp_query_fn *fn, void *ctx);
+void bp_ray_cast(const broadphase *bp, vec3 origin, vec3 dir, double max_t, bp_ray_fn *fn, void *ctx);
+int bp_proxy_count(const broadphase *bp);
+
+#endif

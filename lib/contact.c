@@ -1,0 +1,170 @@
+/* contact.c - contact cache: pair hash map and warm-start point matching. */
+#include <stdlib.h>
+#include <string.h>
+#include "contact.h"
+
+static uint64_t pair_key(int a, int b)
+{
+    if (a > b) { int t = a; a = b; b = t; }
+    return ((uint64_t)(uint32_t)(a + 1) << 32) | (uint64_t)(uint32_t)(b + 1);
+}
+
+static uint32_t hash_key(uint64_t k)
+{
+    k ^= k >> 33;
+    k *= 0xff51afd7ed558ccdULL;
+    k ^= k >> 33;
+    k *= 0xc4ceb9fe1a85ec53ULL;
+    k ^= k >> 33;
+    return (uint32_t)k;
+}
+
+static int map_init(pair_map *m, int capacity)
+{
+    m->keys = calloc((size_t)capacity, sizeof *m->keys);
+    m->values = malloc((size_t)capacity * sizeof *m->values);
+    m->capacity = capacity;
+    m->count = 0;
+    return m->keys && m->values;
+}
+
+static int map_slot(const pair_map *m, uint64_t key)
+{
+    uint32_t mask = (uint32_t)m->capacity - 1;
+    uint32_t i = hash_key(key) & mask;
+    while (m->keys[i] != 0 && m->keys[i] != key) i = (i + 1) & mask;
+    return (int)i;
+}
+
+static void map_put(pair_map *m, uint64_t key, int value)
+{
+    int i = map_slot(m, key);
+    if (m->keys[i] == 0) m->count++;
+    m->keys[i] = key;
+    m->values[i] = value;
+}
+
+static int map_grow(pair_map *m)
+{
+    pair_map n;
+    if (!map_init(&n, m->capacity * 2)) {
+        free(n.keys);
+        free(n.values);
+        return 0;
+    }
+    for (int i = 0; i < m->capacity; i++)
+        if (m->keys[i]) map_put(&n, m->keys[i], m->values[i]);
+    free(m->keys);
+    free(m->values);
+    *m = n;
+    return 1;
+}
+
+/* Backward-shift deletion keeps probe chains intact without tombstones. */
+static void map_remove(pair_map *m, uint64_t key)
+{
+    uint32_t mask = (uint32_t)m->capacity - 1;
+    uint32_t i = (uint32_t)map_slot(m, key);
+    if (m->keys[i] == 0) return;
+    m->keys[i] = 0;
+    m->count--;
+    uint32_t j = i;
+    for (;;) {
+        j = (j + 1) & mask;
+        if (m->keys[j] == 0) return;
+        uint32_t home = hash_key(m->keys[j]) & mask;
+        /* move j back to i unless its home lies cyclically in (i, j] */
+        int keep = (i <= j) ? (i < home && home <= j) : (i < home || home <= j);
+        if (!keep) {
+            m->keys[i] = m->keys[j];
+            m->values[i] = m->values[j];
+            m->keys[j] = 0;
+            i = j;
+        }
+    }
+}
+
+int contact_set_init(contact_set *cs)
+{
+    memset(cs, 0, sizeof *cs);
+    return map_init(&cs->map, 64);
+}
+
+void contact_set_free(contact_set *cs)
+{
+    free(cs->items);
+    free(cs->map.keys);
+    free(cs->map.values);
+    memset(cs, 0, sizeof *cs);
+}
+
+int contact_find(const contact_set *cs, int a, int b)
+{
+    uint64_t key = pair_key(a, b);
+    int i = map_slot(&cs->map, key);
+    return cs->map.keys[i] == key ? cs->map.values[i] : -1;
+}
+
+int contact_add(contact_set *cs, int a, int b)
+{
+    if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
+    if (cs->count >= cs->capacity) {
+        int cap = cs->capacity ? cs->capacity * 2 : 64;
+        contact *n = realloc(cs->items, sizeof *n * (size_t)cap);
+        if (!n) return -1;
+        cs->items = n;
+        cs->capacity = cap;
+    }
+    int i = cs->count++;
+    contact *c = &cs->items[i];
+    memset(c, 0, sizeof *c);
+    c->id_a = a < b ? a : b;
+    c->id_b = a < b ? b : a;
+    c->cache.feature = -1;
+    map_put(&cs->map, pair_key(a, b), i);
+    return i;
+}
+
+void contact_remove(contact_set *cs, int i)
+{
+    contact *c = &cs->items[i];
+    map_remove(&cs->map, pair_key(c->id_a, c->id_b));
+    int last = cs->count - 1;
+    if (i != last) {
+        cs->items[i] = cs->items[last];
+        map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), i);
+    }
+    cs->count--;
+}
+
+void contact_match_points(contact *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
+                          xform xa)
+{
+    /* Points keep their impulses when the same features touch again; a point
+     * whose id changed but that sits within 1 cm of an old one in A's frame
+     * is the same physical contact (ids change when a face clip reorders). */
+    const double match_dist2 = 0.01 * 0.01;
+    int used[MANIFOLD_MAX_POINTS] = {0, 0, 0, 0};
+    for (int i = 0; i < c->m.count; i++) {
+        contact_point_state *s = &c->state[i];
+        vec3 local = xf_inv_point(xa, c->m.points[i].point);
+        memset(s, 0, sizeof *s);
+        s->local_a = local;
+        int found = -1;
+        for (int j = 0; j < old_m->count; j++)
+            if (!used[j] && old_m->points[j].id == c->m.points[i].id) { found = j; break; }
+        if (found < 0) {
+            double best = match_dist2;
+            for (int j = 0; j < old_m->count; j++) {
+                double d2 = v3_len2(v3_sub(old[j].local_a, local));
+                if (!used[j] && d2 < best) { best = d2; found = j; }
+            }
+        }
+        if (found >= 0) {
+            used[found] = 1;
+            s->normal_impulse = old[found].normal_impulse;
+            s->tangent_impulse[0] = old[found].tangent_impulse[0];
+            s->tangent_impulse[1] = old[found].tangent_impulse[1];
+        }
+    }
+}

@@ -1,0 +1,61 @@
+/* contact.h - the persistent contact cache: one contact per broadphase pair,
+ * holding the manifold and the impulses matched across steps by feature id
+ * (falling back to local position) so the solver can warm-start. */
+#ifndef CAROM_CONTACT_H
+#define CAROM_CONTACT_H
+
+#include <stdint.h>
+#include "narrowphase.h"
+
+enum {
+    CONTACT_TOUCHING     = 1u << 0,   /* manifold has points this step */
+    CONTACT_WAS_TOUCHING = 1u << 1,
+    CONTACT_SIM          = 1u << 2    /* solved this step (both bodies not asleep) */
+};
+
+typedef struct contact_point_state {
+    double normal_impulse;      /* accumulated (per sub-step), for warm starting */
+    double tangent_impulse[2];
+    double total_normal_impulse;   /* everything applied over the step */
+    double max_normal_impulse;
+    double relative_velocity;   /* normal velocity before solving (restitution) */
+    vec3 local_a;               /* point in A's body frame (fallback matching) */
+} contact_point_state;
+
+typedef struct contact {
+    int id_a, id_b;             /* body id-table indices, id_a < id_b */
+    uint32_t flags;
+    double friction, restitution;
+    collide_cache cache;
+    manifold m;
+    contact_point_state state[MANIFOLD_MAX_POINTS];
+    vec3 tangent1;              /* friction basis kept across steps */
+} contact;
+
+/* Open-addressing map from an ordered pair of id indices to a contact index. */
+typedef struct pair_map {
+    uint64_t *keys;             /* 0 = empty; key = ((a+1) << 32) | (b+1) */
+    int *values;
+    int capacity;               /* power of two */
+    int count;
+} pair_map;
+
+typedef struct contact_set {
+    contact *items;
+    int count, capacity;
+    pair_map map;
+} contact_set;
+
+int contact_set_init(contact_set *cs);
+void contact_set_free(contact_set *cs);
+/* Index of the contact for (a, b) in any order, or -1. */
+int contact_find(const contact_set *cs, int a, int b);
+/* Adds a contact for a new pair; returns its index or -1 on out of memory. */
+int contact_add(contact_set *cs, int a, int b);
+/* Swap-removes contact i. */
+void contact_remove(contact_set *cs, int i);
+/* Carries warm-start impulses from the old manifold to the new one. */
+void contact_match_points(contact *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
+                          xform xa);
+
+#endif

@@ -1,0 +1,43 @@
+/* narrowphase.h - contact manifolds for a pair of shapes: analytic pairs,
+ * box-box by separating axes and face clipping, libccd for hulls and
+ * cylinders. At most 4 points per manifold. */
+#ifndef CAROM_NARROWPHASE_H
+#define CAROM_NARROWPHASE_H
+
+#include <stdint.h>
+#include "shape.h"
+
+#define MANIFOLD_MAX_POINTS 4
+
+typedef struct manifold_point {
+    vec3 point;          /* world point, midway between the two surfaces */
+    double separation;   /* signed gap along the normal: < 0 overlapping */
+    uint32_t id;         /* feature id: unchanged while the same features touch */
+} manifold_point;
+
+typedef struct manifold {
+    vec3 normal;         /* unit, world frame, pointing from shape A to shape B */
+    int count;           /* 0 .. MANIFOLD_MAX_POINTS */
+    manifold_point points[MANIFOLD_MAX_POINTS];
+} manifold;
+
+/* Per-pair memory kept by the contact cache between steps. Zero it for a new pair. */
+typedef struct collide_cache {
+    vec3 normal;         /* last normal (A to B), valid when has_normal */
+    int has_normal;
+    int feature;         /* last reference feature (box-box / hull SAT axis), -1 none */
+    int flip;            /* last reference face belonged to B */
+} collide_cache;
+
+/* Contacts between shape a at xa and shape b at xb, including speculative
+ * points whose separation is below `speculative` (>= 0). Any order of types
+ * works (the normal always points from a to b). Returns m->count. Results are
+ * always finite. */
+int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative,
+            collide_cache *cache, manifold *m);
+
+/* Reduces up to n candidate points to at most 4 (deepest first, then the
+ * largest area), in place; returns the new count. */
+int manifold_reduce(manifold_point *pts, int n, vec3 normal);
+
+#endif

@@ -1,0 +1,79 @@
+/* shape.h - collision shapes in their body frame: mass properties, bounds,
+ * support mapping, convex hulls. One shape per body. */
+#ifndef CAROM_SHAPE_H
+#define CAROM_SHAPE_H
+
+#include "vecmath.h"
+
+enum {
+    SHAPE_SPHERE = 0,   /* radius, centred on the body origin */
+    SHAPE_BOX,          /* half extents along the body axes */
+    SHAPE_CAPSULE,      /* segment from -half_height to +half_height on local z, plus radius */
+    SHAPE_CYLINDER,     /* axis local z, from -half_height to +half_height, radius */
+    SHAPE_HULL,         /* convex hull, vertices in the body frame */
+    SHAPE_PLANE,        /* static only: points x with dot(normal, x) = offset (body frame); solid below */
+    SHAPE_TYPE_COUNT
+};
+
+/* A hull face: a convex polygon, vertices counter-clockwise seen from outside. */
+typedef struct hull_face {
+    vec3 normal;        /* outward unit normal */
+    double offset;      /* dot(normal, x) = offset on the face plane */
+    int first;          /* index into hull.face_vertices */
+    int count;          /* number of vertices of this face */
+} hull_face;
+
+typedef struct hull {
+    int vertex_count;
+    vec3 *vertices;        /* the hull's extreme points only */
+    int face_count;
+    hull_face *faces;      /* coplanar triangles merged into polygons */
+    int *face_vertices;    /* indices into vertices, per face in order */
+    int edge_count;
+    int (*edges)[2];       /* unique edges as vertex index pairs (for SAT) */
+    vec3 centroid;         /* volume centroid in the body frame */
+    double volume;
+    mat3 unit_inertia;     /* inertia about the centroid for density 1 */
+} hull;
+
+typedef struct shape {
+    int type;
+    double radius;         /* sphere, capsule, cylinder */
+    double half_height;    /* capsule, cylinder */
+    vec3 half_extents;     /* box */
+    hull *hull;            /* SHAPE_HULL: owned by the shape */
+    vec3 plane_normal;     /* SHAPE_PLANE: unit */
+    double plane_offset;
+} shape;
+
+typedef struct mass_props {
+    double mass;
+    vec3 center;           /* centre of mass in the body frame */
+    mat3 inertia;          /* about the centre of mass, body axes */
+} mass_props;
+
+/* Volume of a shape (0 for a plane). */
+double shape_volume(const shape *s);
+/* Mass properties for a density (kg/m^3). */
+mass_props shape_mass_from_density(const shape *s, double density);
+/* Same shape, scaled to a given total mass. */
+mass_props shape_mass_from_mass(const shape *s, double mass);
+/* World-space bounds of the shape at transform t (a plane gives huge bounds). */
+aabb shape_aabb(const shape *s, xform t);
+/* Support point in the body frame: the point of the shape farthest along dir
+ * (dir need not be unit; a zero dir returns some point of the shape). */
+vec3 shape_support_local(const shape *s, vec3 dir);
+/* Bounding radius about the body origin (used for continuous collision). */
+double shape_bounding_radius(const shape *s);
+/* Builds a hull from points (xyz triples). Returns NULL and writes a message to
+ * err when the points are degenerate (fewer than 4, coplanar, non-finite). */
+hull *hull_build(const double *points, int count, char *err, int err_size);
+hull *hull_make_box(vec3 half_extents);
+void hull_free(hull *h);
+hull *hull_clone(const hull *h);
+/* Ray cast against a shape in its body frame: origin o, direction d (not unit),
+ * t in [0, max_t]. Returns 1 and sets *t and *normal (outward) on a hit;
+ * a ray starting inside the shape does not hit. */
+int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t, vec3 *normal);
+
+#endif

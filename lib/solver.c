@@ -1,0 +1,517 @@
+/* solver.c - the soft-step sequential impulse solver. Per step: gather the
+ * awake bodies contiguously, build constraints from touching manifolds, then
+ * per sub-step integrate velocities, warm start, solve (biased), integrate
+ * positions, relax (unbiased); after the sub-steps apply restitution from the
+ * normal velocity stored before solving, and store impulses for next step. */
+#include <stdlib.h>
+#include <string.h>
+#include "solver.h"
+
+#define TWO_PI 6.283185307179586
+
+softness make_softness(double hertz, double zeta, double h)
+{
+    softness s = {0.0, 1.0, 0.0};
+    if (hertz <= 0) return s;
+    double omega = TWO_PI * hertz;
+    double a1 = 2.0 * zeta + h * omega;
+    double a2 = h * omega * a1;
+    double a3 = 1.0 / (1.0 + a2);
+    s.bias_rate = omega / a1;
+    s.mass_scale = a2 * a3;
+    s.impulse_scale = a3;
+    return s;
+}
+
+static int ensure_capacity(void **p, int *cap, int need, size_t elem)
+{
+    if (need <= *cap) return 1;
+    int n = *cap ? *cap : 64;
+    while (n < need) n *= 2;
+    void *q = realloc(*p, elem * (size_t)n);
+    if (!q) return 0;
+    *p = q;
+    *cap = n;
+    return 1;
+}
+
+typedef struct solve_context {
+    impulse_body *bodies;
+    vec3 *dp, *dq;
+    double inv_h;
+    double push_max, slop, baumgarte;
+    carom_position_correction correction;
+    int friction;
+} solve_context;
+
+/* Normal then friction rows of one manifold; use_bias selects the solve pass
+ * (position error fed back) over the relax pass (velocity only). */
+static void solve_constraint(contact_constraint *c, const solve_context *sc, int use_bias)
+{
+    impulse_body *A = &sc->bodies[c->a], *B = &sc->bodies[c->b];
+    vec3 vA = A->v, wA = A->w, vB = B->v, wB = B->w;
+    double mA = A->inv_mass, mB = B->inv_mass;
+    vec3 n = c->n;
+    vec3 dpab = v3_sub(sc->dp[c->b], sc->dp[c->a]);
+    vec3 dqa = sc->dq[c->a], dqb = sc->dq[c->b];
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        /* current separation: small-angle update of the anchors */
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, p->rb_n) - v3_dot(dqa, p->ra_n);
+        double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+        if (s > 0.0) {
+            bias = s * sc->inv_h; /* speculative: arrive exactly at contact */
+        } else if (use_bias) {
+            if (sc->correction == CAROM_CORRECTION_SOFT) {
+                bias = fmax(c->soft.bias_rate * s, -sc->push_max);
+                mass_scale = c->soft.mass_scale;
+                impulse_scale = c->soft.impulse_scale;
+            } else if (sc->correction == CAROM_CORRECTION_BAUMGARTE) {
+                bias = fmax(sc->baumgarte * sc->inv_h * fmin(s + sc->slop, 0.0), -sc->push_max);
+            }
+        }
+        double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, p->rb_n) - v3_dot(wA, p->ra_n);
+        double lambda = -p->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
+        double total = fmax(p->normal_impulse + lambda, 0.0);
+        lambda = total - p->normal_impulse;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        if (total > p->max_normal_impulse) p->max_normal_impulse = total;
+        vA = v3_madd(vA, -mA * lambda, n);
+        wA = v3_madd(wA, -lambda, p->ia_n);
+        vB = v3_madd(vB, mB * lambda, n);
+        wB = v3_madd(wB, lambda, p->ib_n);
+    }
+    if (sc->friction && c->friction > 0) {
+        for (int i = 0; i < c->count; i++) {
+            constraint_point *p = &c->p[i];
+            vec3 vp = v3_sub(v3_add(vB, v3_cross(wB, p->rb)), v3_add(vA, v3_cross(wA, p->ra)));
+            double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+            double n1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1);
+            double n2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
+            /* Coulomb cone: |friction| <= mu * normal impulse */
+            double limit = c->friction * p->normal_impulse;
+            double mag2 = n1 * n1 + n2 * n2;
+            if (mag2 > limit * limit) {
+                double k = limit / sqrt(mag2);
+                n1 *= k;
+                n2 *= k;
+            }
+            p->tangent_impulse[0] = n1;
+            p->tangent_impulse[1] = n2;
+            vec3 P = v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2));
+            vA = v3_madd(vA, -mA, P);
+            wA = v3_sub(wA, m3_mulv(A->inv_inertia, v3_cross(p->ra, P)));
+            vB = v3_madd(vB, mB, P);
+            wB = v3_add(wB, m3_mulv(B->inv_inertia, v3_cross(p->rb, P)));
+        }
+    }
+    A->v = vA; A->w = wA;
+    B->v = vB; B->w = wB;
+}
+
+/* Shock propagation (Guendelman et al. 2003): the body nearer the ground is
+ * treated as immovable, so a heavy body is held by the light body under it
+ * instead of slowly crushing it (an iterative solver converges at a rate set
+ * by the mass ratio). Constraints arrive sorted bottom-up. */
+static void solve_constraint_shock(contact_constraint *c, const solve_context *sc, int use_bias, int lower_is_a)
+{
+    impulse_body *A = &sc->bodies[c->a], *B = &sc->bodies[c->b];
+    /* fa, fb scale each body's response: the lower body gets 0 */
+    double fa = lower_is_a ? 0.0 : 1.0, fb = lower_is_a ? 1.0 : 0.0;
+    vec3 n = c->n;
+    vec3 dpab = v3_sub(sc->dp[c->b], sc->dp[c->a]);
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(sc->dq[c->b], p->rb_n) - v3_dot(sc->dq[c->a], p->ra_n);
+        double k = fa * (A->inv_mass + v3_dot(p->ra_n, p->ia_n)) + fb * (B->inv_mass + v3_dot(p->rb_n, p->ib_n));
+        if (k <= 0) continue;
+        double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+        if (s > 0.0) bias = s * sc->inv_h;
+        else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) {
+            bias = fmax(c->soft.bias_rate * s, -sc->push_max);
+            mass_scale = c->soft.mass_scale;
+            impulse_scale = c->soft.impulse_scale;
+        } else if (use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE)
+            bias = fmax(sc->baumgarte * sc->inv_h * fmin(s + sc->slop, 0.0), -sc->push_max);
+        double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, p->rb_n) - v3_dot(A->w, p->ra_n);
+        double lambda = -(mass_scale / k) * (vn + bias) - impulse_scale * p->normal_impulse;
+        double total = fmax(p->normal_impulse + lambda, 0.0);
+        lambda = total - p->normal_impulse;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
+        A->w = v3_madd(A->w, -fa * lambda, p->ia_n);
+        B->v = v3_madd(B->v, fb * B->inv_mass * lambda, n);
+        B->w = v3_madd(B->w, fb * lambda, p->ib_n);
+    }
+    if (!sc->friction || c->friction <= 0) return;
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        vec3 vp = v3_sub(v3_add(B->v, v3_cross(B->w, p->rb)), v3_add(A->v, v3_cross(A->w, p->ra)));
+        vec3 t[2] = {c->t1, c->t2};
+        double o[2] = {p->tangent_impulse[0], p->tangent_impulse[1]}, nw[2];
+        for (int j = 0; j < 2; j++) {
+            vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
+            double k = fa * (A->inv_mass + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
+                       fb * (B->inv_mass + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
+            nw[j] = k > 0 ? o[j] - v3_dot(vp, t[j]) / k : o[j];
+        }
+        double limit = c->friction * p->normal_impulse, mag2 = nw[0] * nw[0] + nw[1] * nw[1];
+        if (mag2 > limit * limit) {
+            double sc2 = limit / sqrt(mag2);
+            nw[0] *= sc2;
+            nw[1] *= sc2;
+        }
+        p->tangent_impulse[0] = nw[0];
+        p->tangent_impulse[1] = nw[1];
+        vec3 P = v3_add(v3_scale(t[0], nw[0] - o[0]), v3_scale(t[1], nw[1] - o[1]));
+        A->v = v3_madd(A->v, -fa * A->inv_mass, P);
+        A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
+        B->v = v3_madd(B->v, fb * B->inv_mass, P);
+        B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(p->rb, P)), fb));
+    }
+}
+
+static void warm_start(contact_constraint *cc, int n, impulse_body *bodies)
+{
+    for (int k = 0; k < n; k++) {
+        contact_constraint *c = &cc[k];
+        impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
+        for (int i = 0; i < c->count; i++) {
+            constraint_point *p = &c->p[i];
+            vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
+                            v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
+            p->total_normal_impulse += p->normal_impulse;
+            /* seed convention: body 1 = B receives +P (n points from A to B) */
+            impulse_apply(B, A, p->rb, p->ra, P);
+        }
+    }
+}
+
+static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodies, double threshold)
+{
+    for (int k = 0; k < n; k++) {
+        contact_constraint *c = &cc[k];
+        if (c->restitution == 0.0) continue;
+        impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
+        for (int i = 0; i < c->count; i++) {
+            constraint_point *p = &c->p[i];
+            if (p->relative_velocity > -threshold || p->max_normal_impulse == 0.0) continue;
+            double vn = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
+            double lambda = -p->normal_mass * (vn + c->restitution * p->relative_velocity);
+            double total = fmax(p->normal_impulse + lambda, 0.0);
+            lambda = total - p->normal_impulse;
+            p->normal_impulse = total;
+            p->total_normal_impulse += lambda;
+            if (total > p->max_normal_impulse) p->max_normal_impulse = total;
+            impulse_apply(B, A, p->rb, p->ra, v3_scale(c->n, lambda));
+        }
+    }
+}
+
+/* Keeps plane-locked bodies in their plane: in-plane velocity, spin about the normal. */
+static void project_planar(carom_world *w, int nb)
+{
+    step_scratch *s = &w->scratch;
+    body_store *bs = &w->bodies;
+    for (int k = 1; k < nb; k++) {
+        int slot = s->body_slot[k];
+        if (!(bs->flags[slot] & BODY_LOCK_PLANE)) continue;
+        vec3 nrm = bs->plane_normal[slot];
+        impulse_body *b = &s->bodies[k];
+        b->v = v3_madd(b->v, -v3_dot(b->v, nrm), nrm);
+        b->w = v3_scale(nrm, v3_dot(b->w, nrm));
+    }
+}
+
+/* Levels above the ground (static/kinematic = 0) by repeated relaxation over
+ * the contact graph; bodies not resting on anything stay at INT_MAX / 2. */
+static void compute_levels(contact_constraint *cc, int n, int *level, int nb, int *order, int *count_buf)
+{
+    const int far = 1 << 29;
+    level[0] = 0;
+    for (int k = 1; k < nb; k++) level[k] = far;
+    for (int k = 0; k < n; k++) {
+        /* kinematic bodies (inv mass 0) are ground too */
+        (void)k;
+    }
+    int changed = 1;
+    for (int pass = 0; changed && pass < nb + 1; pass++) {
+        changed = 0;
+        for (int k = 0; k < n; k++) {
+            int a = cc[k].a, b = cc[k].b;
+            if (level[a] + 1 < level[b]) { level[b] = level[a] + 1; changed = 1; }
+            if (level[b] + 1 < level[a]) { level[a] = level[b] + 1; changed = 1; }
+        }
+    }
+    /* counting sort of constraints by their lower level (capped) */
+    int max_level = 0;
+    for (int k = 0; k < n; k++) {
+        int l = level[cc[k].a] < level[cc[k].b] ? level[cc[k].a] : level[cc[k].b];
+        if (l > nb) l = nb;
+        cc[k].level = l;
+        if (l > max_level) max_level = l;
+    }
+    for (int l = 0; l <= max_level + 1; l++) count_buf[l] = 0;
+    for (int k = 0; k < n; k++) count_buf[cc[k].level + 1]++;
+    for (int l = 1; l <= max_level + 1; l++) count_buf[l] += count_buf[l - 1];
+    for (int k = 0; k < n; k++) order[count_buf[cc[k].level]++] = k;
+}
+
+int world_solve(carom_world *w, double dt)
+{
+    body_store *bs = &w->bodies;
+    step_scratch *s = &w->scratch;
+    contact_set *cs = &w->contacts;
+    const carom_world_def *def = &w->def;
+    int substeps = def->substeps;
+    double h = dt / substeps;
+
+    /* gather awake bodies: index 0 is the shared immovable body */
+    int nb = 1;
+    for (int i = 0; i < bs->count; i++) bs->solver_index[i] = 0;
+    if (!ensure_capacity((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
+    {
+        int cap = s->body_capacity;
+        /* the per-body scratch arrays share one capacity */
+        void *p1 = realloc(s->bodies, sizeof *s->bodies * (size_t)cap);
+        if (!p1) return 0;
+        s->bodies = p1;
+        void *p2 = realloc(s->delta_position, sizeof *s->delta_position * (size_t)cap);
+        if (!p2) return 0;
+        s->delta_position = p2;
+        void *p3 = realloc(s->delta_rotation, sizeof *s->delta_rotation * (size_t)cap);
+        if (!p3) return 0;
+        s->delta_rotation = p3;
+    }
+    impulse_body *bodies = s->bodies;
+    memset(&bodies[0], 0, sizeof bodies[0]);
+    s->delta_position[0] = v3_zero();
+    s->delta_rotation[0] = v3_zero();
+    s->body_slot[0] = -1;
+    for (int i = 0; i < bs->count; i++) {
+        if (bs->type[i] == CAROM_BODY_STATIC || !(bs->flags[i] & BODY_AWAKE)) continue;
+        int k = nb++;
+        bs->solver_index[i] = k;
+        s->body_slot[k] = i;
+        bodies[k].v = bs->velocity[i];
+        bodies[k].w = bs->angular_velocity[i];
+        bodies[k].inv_mass = bs->inv_mass[i];
+        bodies[k].inv_inertia = bs->inv_inertia_world[i];
+        s->delta_position[k] = v3_zero();
+        s->delta_rotation[k] = v3_zero();
+    }
+
+    /* constraints from touching manifolds */
+    int ncon = 0;
+    for (int i = 0; i < cs->count; i++)
+        if ((cs->items[i].flags & (CONTACT_SIM | CONTACT_TOUCHING)) == (CONTACT_SIM | CONTACT_TOUCHING)) ncon++;
+    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(int) * (size_t)(3 * ncon + 2 * nb + 4);
+    if (!ensure_capacity(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
+    contact_constraint *cc = s->constraints;
+    int *order = (int *)(cc + ncon);
+    int *level = order + ncon;
+    int *count_buf = level + nb + 1;
+
+    double contact_hertz = fmin(def->contact_hertz, 0.25 / h);
+    softness soft = make_softness(contact_hertz, def->contact_damping_ratio, h);
+    softness static_soft = make_softness(2.0 * contact_hertz, def->contact_damping_ratio, h);
+    double ws = def->warm_starting ? 1.0 : 0.0;
+    int friction_on = def->enable_friction;
+    int penalty = def->contact_model == CAROM_CONTACT_PENALTY;
+    double max_pen = 0.0;
+    int contacts_touching = 0, points = 0;
+
+    int k = 0;
+    for (int i = 0; i < cs->count; i++) {
+        contact *ct = &cs->items[i];
+        if ((ct->flags & (CONTACT_SIM | CONTACT_TOUCHING)) != (CONTACT_SIM | CONTACT_TOUCHING)) continue;
+        int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
+        contact_constraint *c = &cc[k++];
+        c->a = bs->solver_index[sa];
+        c->b = bs->solver_index[sb];
+        c->contact = i;
+        c->count = ct->m.count;
+        c->n = ct->m.normal;
+        /* keep the friction basis stable across steps while the normal holds still */
+        vec3 t1 = v3_sub(ct->tangent1, v3_scale(c->n, v3_dot(ct->tangent1, c->n)));
+        if (v3_len2(t1) < 0.25) { vec3 t2; v3_basis(c->n, &t1, &t2); }
+        t1 = v3_normalize(t1);
+        ct->tangent1 = t1;
+        c->t1 = t1;
+        c->t2 = v3_cross(c->n, t1);
+        c->friction = ct->friction;
+        c->restitution = def->enable_restitution ? ct->restitution : 0.0;
+        c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? static_soft : soft;
+        impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
+        vec3 ca = bs->center[sa], cb = bs->center[sb];
+        contacts_touching++;
+        for (int j = 0; j < c->count; j++) {
+            const manifold_point *mp = &ct->m.points[j];
+            constraint_point *p = &c->p[j];
+            p->ra = v3_sub(mp->point, ca);
+            p->rb = v3_sub(mp->point, cb);
+            p->ra_n = v3_cross(p->ra, c->n);
+            p->rb_n = v3_cross(p->rb, c->n);
+            p->ia_n = m3_mulv(A->inv_inertia, p->ra_n);
+            p->ib_n = m3_mulv(B->inv_inertia, p->rb_n);
+            double kn = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->n);
+            double k1 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t1);
+            double k2 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t2);
+            p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
+            p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
+            p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
+            p->base_separation = mp->separation;
+            p->relative_velocity = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
+            p->normal_impulse = ws * ct->state[j].normal_impulse;
+            p->tangent_impulse[0] = ws * ct->state[j].tangent_impulse[0];
+            p->tangent_impulse[1] = ws * ct->state[j].tangent_impulse[1];
+            p->total_normal_impulse = 0.0;
+            p->max_normal_impulse = 0.0;
+            if (penalty) {
+                double omega = TWO_PI * contact_hertz;
+                p->penalty_k = def->penalty_stiffness > 0 ? def->penalty_stiffness : p->normal_mass * omega * omega;
+                p->penalty_c = def->penalty_damping > 0 ? def->penalty_damping : 2.0 * p->normal_mass * omega;
+                p->normal_impulse = 0.0;
+                p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
+            }
+            if (-mp->separation > max_pen) max_pen = -mp->separation;
+            points++;
+        }
+    }
+    int shock = def->shock_propagation && !penalty;
+    if (shock) compute_levels(cc, ncon, level, nb, order, count_buf);
+
+    solve_context sc = {bodies, s->delta_position, s->delta_rotation, 1.0 / h,
+                        def->contact_push_max_velocity, def->linear_slop, def->baumgarte,
+                        def->position_correction, friction_on};
+    vec3 g = v3(def->gravity.x, def->gravity.y, def->gravity.z);
+
+    for (int step = 0; step < substeps; step++) {
+        /* integrate velocities */
+        for (int b = 1; b < nb; b++) {
+            int slot = s->body_slot[b];
+            impulse_body *B = &bodies[b];
+            if (B->inv_mass == 0.0) continue; /* kinematic */
+            vec3 acc = v3_madd(v3_scale(g, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
+            B->v = v3_madd(B->v, h, acc);
+            if (bs->linear_damping[slot] > 0) B->v = v3_scale(B->v, 1.0 / (1.0 + h * bs->linear_damping[slot]));
+            if (bs->angular_damping[slot] > 0) B->w = v3_scale(B->w, 1.0 / (1.0 + h * bs->angular_damping[slot]));
+        }
+        project_planar(w, nb);
+        if (penalty) {
+            penalty_solve(w, cc, ncon, h);
+        } else {
+            if (def->warm_starting) warm_start(cc, ncon, bodies);
+            for (int it = 0; it < def->iterations; it++)
+                for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 1);
+            if (shock)
+                for (int o = 0; o < ncon; o++) {
+                    contact_constraint *c = &cc[order[o]];
+                    if (level[c->a] != level[c->b]) solve_constraint_shock(c, &sc, 1, level[c->a] < level[c->b]);
+                }
+        }
+        project_planar(w, nb);
+        /* integrate positions */
+        for (int b = 1; b < nb; b++) {
+            int slot = s->body_slot[b];
+            impulse_body *B = &bodies[b];
+            vec3 dx = v3_scale(B->v, h);
+            bs->center[slot] = v3_add(bs->center[slot], dx);
+            s->delta_position[b] = v3_add(s->delta_position[b], dx);
+            if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
+                bs->rotation[slot] = q_integrate(bs->rotation[slot], B->w, h);
+                s->delta_rotation[b] = v3_madd(s->delta_rotation[b], h, B->w);
+            }
+        }
+        if (!penalty) {
+            for (int it = 0; it < def->relax_iterations; it++)
+                for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 0);
+            if (shock && def->relax_iterations > 0)
+                for (int o = 0; o < ncon; o++) {
+                    contact_constraint *c = &cc[order[o]];
+                    if (level[c->a] != level[c->b]) solve_constraint_shock(c, &sc, 0, level[c->a] < level[c->b]);
+                }
+            project_planar(w, nb);
+        }
+    }
+    if (!penalty && def->enable_restitution) {
+        apply_restitution(cc, ncon, bodies, def->restitution_threshold);
+        project_planar(w, nb);
+    }
+
+    /* store impulses for warm starting, raise hit events */
+    for (int c = 0; c < ncon; c++) {
+        contact_constraint *con = &cc[c];
+        contact *ct = &cs->items[con->contact];
+        double approach = 0.0, total = 0.0, tangent = 0.0;
+        int deepest = 0;
+        for (int j = 0; j < con->count; j++) {
+            constraint_point *p = &con->p[j];
+            ct->state[j].normal_impulse = p->normal_impulse;
+            ct->state[j].tangent_impulse[0] = p->tangent_impulse[0];
+            ct->state[j].tangent_impulse[1] = p->tangent_impulse[1];
+            ct->state[j].total_normal_impulse = p->total_normal_impulse;
+            ct->state[j].max_normal_impulse = p->max_normal_impulse;
+            ct->state[j].relative_velocity = p->relative_velocity;
+            total += p->total_normal_impulse;
+            tangent += hypot(p->tangent_impulse[0], p->tangent_impulse[1]) * substeps;
+            if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
+        }
+        if (approach > def->restitution_threshold && total > 0.0) {
+            carom_contact_event e;
+            memset(&e, 0, sizeof e);
+            e.type = CAROM_EVENT_HIT;
+            e.a = world_make_id(w, ct->id_a);
+            e.b = world_make_id(w, ct->id_b);
+            vec3 pt = ct->m.points[deepest].point;
+            e.point.x = pt.x; e.point.y = pt.y; e.point.z = pt.z;
+            e.normal.x = con->n.x; e.normal.y = con->n.y; e.normal.z = con->n.z;
+            e.normal_impulse = total;
+            e.tangent_impulse = tangent;
+            e.approach_speed = approach;
+            e.average_force = impulse_average_force(total, dt);
+            world_push_event(w, &e);
+        }
+    }
+
+    /* write velocities back; clamp and guard */
+    int clamped = 0, awake = 0;
+    double vmax = def->max_linear_speed, wmax = def->max_angular_speed;
+    for (int b = 1; b < nb; b++) {
+        int slot = s->body_slot[b];
+        vec3 v = bodies[b].v, av = bodies[b].w;
+        double sp = v3_len(v), ap = v3_len(av);
+        if (sp > vmax) { v = v3_scale(v, vmax / sp); clamped++; }
+        if (ap > wmax) { av = v3_scale(av, wmax / ap); clamped++; }
+        if (!v3_is_finite(v) || !v3_is_finite(av) || !v3_is_finite(bs->center[slot])) {
+            /* never propagate NaN: undo this step's motion and stop the body */
+            bs->center[slot] = v3_sub(bs->center[slot], s->delta_position[b]);
+            if (!v3_is_finite(bs->center[slot])) bs->center[slot] = v3_zero();
+            bs->rotation[slot] = q_normalize(bs->rotation[slot]);
+            v = v3_zero();
+            av = v3_zero();
+            w->stats.non_finite++;
+        }
+        bs->velocity[slot] = v;
+        bs->angular_velocity[slot] = av;
+        if (bs->flags[slot] & BODY_LOCK_PLANE) {
+            vec3 nrm = bs->plane_normal[slot];
+            bs->center[slot] = v3_madd(bs->center[slot], bs->plane_offset[slot] - v3_dot(nrm, bs->center[slot]), nrm);
+        }
+        if (bs->flags[slot] & BODY_HAS_FORCE) {
+            bs->force[slot] = v3_zero();
+            bs->flags[slot] &= ~(uint32_t)BODY_HAS_FORCE;
+        }
+        body_update_inertia(bs, slot);
+        awake++;
+    }
+    w->stats.clamped += clamped;
+    w->stats.awake_bodies = awake;
+    w->stats.contacts = contacts_touching;
+    w->stats.contact_points = points;
+    w->stats.pairs = cs->count;
+    w->stats.max_penetration = max_pen;
+    return 1;
+}

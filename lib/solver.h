@@ -1,0 +1,39 @@
+/* solver.h - contact constraints shared by the impulse solver (solver.c) and
+ * the penalty model (penalty.c). */
+#ifndef CAROM_SOLVER_H
+#define CAROM_SOLVER_H
+
+#include "world.h"
+
+typedef struct softness {
+    double bias_rate, mass_scale, impulse_scale;
+} softness;
+
+typedef struct constraint_point {
+    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
+    vec3 ra_n, rb_n;             /* ra x n, rb x n */
+    vec3 ia_n, ib_n;             /* IA^-1 (ra x n), IB^-1 (rb x n) */
+    double normal_mass, tangent_mass[2];
+    double base_separation;
+    double relative_velocity;    /* normal velocity before solving (restitution) */
+    double normal_impulse, tangent_impulse[2];
+    double total_normal_impulse, max_normal_impulse;
+    double penalty_k, penalty_c; /* penalty model spring and damper */
+} constraint_point;
+
+typedef struct contact_constraint {
+    int a, b;                    /* solver bodies (0 = the shared static body) */
+    int contact;                 /* index in the contact set */
+    int count;
+    int level;                   /* shock propagation: lower of the two body levels */
+    vec3 n, t1, t2;
+    double friction, restitution;
+    softness soft;
+    constraint_point p[MANIFOLD_MAX_POINTS];
+} contact_constraint;
+
+softness make_softness(double hertz, double damping_ratio, double h);
+/* Penalty springs: one sub-step of spring forces (penalty.c). */
+void penalty_solve(carom_world *w, contact_constraint *cc, int n, double h);
+
+#endif

@@ -1,0 +1,295 @@
+/* world.c - world lifecycle, settings and presets, errors, and the step. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "world.h"
+
+CAROM_API const char *carom_version(void) { return "1.0.0"; }
+
+CAROM_API const char *carom_status_string(carom_status status)
+{
+    switch (status) {
+    case CAROM_OK: return "ok";
+    case CAROM_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case CAROM_ERROR_STALE_ID: return "stale or invalid body id";
+    case CAROM_ERROR_LOCKED: return "world is locked (inside step or callback)";
+    case CAROM_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case CAROM_ERROR_UNSUPPORTED: return "unsupported operation";
+    }
+    return "unknown status";
+}
+
+carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
+{
+    if (w) {
+        /* The message buffer is diagnostic state, not simulation state: const
+         * getters may record why they failed. */
+        carom_world *mw = (carom_world *)(uintptr_t)w;
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(mw->error, sizeof mw->error, fmt, ap);
+        va_end(ap);
+    }
+    return status;
+}
+
+CAROM_API const char *carom_world_last_error(const carom_world *world)
+{
+    return world ? world->error : "world is NULL";
+}
+
+/* ---- settings -------------------------------------------------------------- */
+
+/* Copies the caller's def (of its own compile-time size) over our defaults. */
+static int def_import(const carom_world_def *in, carom_world_def *out, char *msg, size_t n)
+{
+    *out = carom_world_def_default();
+    if (!in) { snprintf(msg, n, "world def is NULL"); return 0; }
+    if (in->size < offsetof(carom_world_def, gravity) + sizeof(carom_vec3)) {
+        snprintf(msg, n, "world def size %u is too small: initialise it with carom_world_def_default()",
+                 (unsigned)in->size);
+        return 0;
+    }
+    size_t sz = in->size < sizeof *out ? in->size : sizeof *out;
+    memcpy(out, in, sz);
+    out->size = (uint32_t)sizeof *out;
+    return 1;
+}
+
+static int finite3(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+static int def_validate(const carom_world_def *d, char *msg, size_t n)
+{
+#define REQUIRE(cond, ...) do { if (!(cond)) { snprintf(msg, n, __VA_ARGS__); return 0; } } while (0)
+    REQUIRE(finite3(d->gravity), "gravity must be finite");
+    REQUIRE(d->substeps >= 1 && d->substeps <= 64, "substeps must be in 1..64 (got %d)", d->substeps);
+    REQUIRE(d->iterations >= 1 && d->iterations <= 256, "iterations must be in 1..256 (got %d)", d->iterations);
+    REQUIRE(d->relax_iterations >= 0 && d->relax_iterations <= 256, "relax_iterations must be in 0..256 (got %d)",
+            d->relax_iterations);
+    REQUIRE(d->position_correction >= CAROM_CORRECTION_SOFT && d->position_correction <= CAROM_CORRECTION_NONE,
+            "position_correction must be SOFT, BAUMGARTE or NONE");
+    REQUIRE(d->contact_model == CAROM_CONTACT_IMPULSE || d->contact_model == CAROM_CONTACT_PENALTY,
+            "contact_model must be IMPULSE or PENALTY");
+    REQUIRE(isfinite(d->restitution_threshold) && d->restitution_threshold >= 0,
+            "restitution_threshold must be finite and >= 0");
+    REQUIRE(isfinite(d->contact_hertz) && d->contact_hertz > 0, "contact_hertz must be finite and > 0");
+    REQUIRE(isfinite(d->contact_damping_ratio) && d->contact_damping_ratio >= 0,
+            "contact_damping_ratio must be finite and >= 0");
+    REQUIRE(isfinite(d->contact_push_max_velocity) && d->contact_push_max_velocity > 0,
+            "contact_push_max_velocity must be finite and > 0");
+    REQUIRE(isfinite(d->baumgarte) && d->baumgarte >= 0 && d->baumgarte <= 1, "baumgarte must be in [0, 1]");
+    REQUIRE(isfinite(d->linear_slop) && d->linear_slop >= 0 && d->linear_slop < 1, "linear_slop must be in [0, 1)");
+    REQUIRE(isfinite(d->speculative_distance) && d->speculative_distance >= 0 && d->speculative_distance < 10,
+            "speculative_distance must be in [0, 10)");
+    REQUIRE(isfinite(d->penalty_stiffness) && d->penalty_stiffness >= 0, "penalty_stiffness must be finite and >= 0");
+    REQUIRE(isfinite(d->penalty_damping) && d->penalty_damping >= 0, "penalty_damping must be finite and >= 0");
+    REQUIRE(isfinite(d->sleep_time) && d->sleep_time >= 0, "sleep_time must be finite and >= 0");
+    REQUIRE(isfinite(d->sleep_linear_velocity) && d->sleep_linear_velocity >= 0,
+            "sleep_linear_velocity must be finite and >= 0");
+    REQUIRE(isfinite(d->sleep_angular_velocity) && d->sleep_angular_velocity >= 0,
+            "sleep_angular_velocity must be finite and >= 0");
+    REQUIRE(d->max_linear_speed > 0 && d->max_linear_speed <= 1e9, "max_linear_speed must be in (0, 1e9]");
+    REQUIRE(d->max_angular_speed > 0 && d->max_angular_speed <= 1e9, "max_angular_speed must be in (0, 1e9]");
+    REQUIRE(d->body_capacity >= 0 && d->body_capacity <= (1 << 26), "body_capacity must be in 0..2^26");
+#undef REQUIRE
+    return 1;
+}
+
+CAROM_API carom_status carom_world_def_check(const carom_world_def *def, char *msg, size_t msg_size)
+{
+    char local[WORLD_ERROR_SIZE];
+    carom_world_def d;
+    if (!msg || msg_size == 0) { msg = local; msg_size = sizeof local; }
+    msg[0] = '\0';
+    if (!def_import(def, &d, msg, msg_size) || !def_validate(&d, msg, msg_size))
+        return CAROM_ERROR_INVALID_ARGUMENT;
+    return CAROM_OK;
+}
+
+/* Presets derived from the measured speed/accuracy fronts (README, "Choosing settings"). */
+CAROM_API carom_status carom_world_def_apply_preset(carom_world_def *def, const char *preset)
+{
+    if (!def || !preset) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (def->size < sizeof(uint32_t)) return CAROM_ERROR_INVALID_ARGUMENT;
+    carom_world_def d = carom_world_def_default();
+    size_t sz = def->size < sizeof d ? def->size : sizeof d;
+    memcpy(&d, def, sz);
+    if (strcmp(preset, "default") == 0) {
+        d.substeps = 4; d.iterations = 1; d.relax_iterations = 1;
+        d.contact_hertz = 30.0; d.contact_damping_ratio = 10.0;
+    } else if (strcmp(preset, "fast") == 0) {
+        d.substeps = 2; d.iterations = 1; d.relax_iterations = 1;
+        d.contact_hertz = 15.0; d.contact_damping_ratio = 10.0;
+    } else if (strcmp(preset, "accurate") == 0) {
+        d.substeps = 8; d.iterations = 2; d.relax_iterations = 1;
+        d.contact_hertz = 60.0; d.contact_damping_ratio = 10.0;
+    } else {
+        return CAROM_ERROR_INVALID_ARGUMENT;
+    }
+    d.position_correction = CAROM_CORRECTION_SOFT;
+    d.warm_starting = 1;
+    d.contact_model = CAROM_CONTACT_IMPULSE;
+    memcpy(def, &d, sz);
+    def->size = (uint32_t)sz;
+    return CAROM_OK;
+}
+
+CAROM_API carom_world *carom_world_create(const carom_world_def *def)
+{
+    char msg[WORLD_ERROR_SIZE];
+    carom_world_def d;
+    if (!def_import(def, &d, msg, sizeof msg) || !def_validate(&d, msg, sizeof msg)) return NULL;
+    carom_world *w = calloc(1, sizeof *w);
+    if (!w) return NULL;
+    w->def = d;
+    w->bp = bp_create();
+    if (!w->bp || !body_store_init(&w->bodies, d.body_capacity) || !contact_set_init(&w->contacts)) {
+        carom_world_destroy(w);
+        return NULL;
+    }
+    w->stats = carom_world_stats_init();
+    return w;
+}
+
+CAROM_API void carom_world_destroy(carom_world *w)
+{
+    if (!w) return;
+    for (int i = 0; i < w->bodies.count; i++) hull_free(w->bodies.shapes[i].hull);
+    body_store_free(&w->bodies);
+    if (w->bp) bp_destroy(w->bp);
+    contact_set_free(&w->contacts);
+    free(w->events.items);
+    step_scratch *s = &w->scratch;
+    free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
+    free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
+    free(s->start_center); free(s->start_rotation);
+    free(w);
+}
+
+CAROM_API carom_status carom_world_set_def(carom_world *w, const carom_world_def *def)
+{
+    char msg[WORLD_ERROR_SIZE];
+    carom_world_def d;
+    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "set_def: world is locked");
+    if (!def_import(def, &d, msg, sizeof msg) || !def_validate(&d, msg, sizeof msg))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "set_def: %s", msg);
+    int wake = d.enable_sleep != w->def.enable_sleep || !finite3(d.gravity) ||
+               d.gravity.x != w->def.gravity.x || d.gravity.y != w->def.gravity.y || d.gravity.z != w->def.gravity.z;
+    w->def = d;
+    if (wake)
+        for (int i = 0; i < w->bodies.count; i++) world_wake_body(w, i);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_world_get_def(const carom_world *w, carom_world_def *def)
+{
+    if (!w || !def) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (def->size < sizeof(uint32_t)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "get_def: def->size not set");
+    size_t sz = def->size < sizeof w->def ? def->size : sizeof w->def;
+    memcpy(def, &w->def, sz);
+    def->size = (uint32_t)sz;
+    return CAROM_OK;
+}
+
+CAROM_API int carom_world_body_count(const carom_world *w) { return w ? w->bodies.count : 0; }
+
+int world_push_event(carom_world *w, const carom_contact_event *e)
+{
+    event_buffer *b = &w->events;
+    if (b->count >= b->capacity) {
+        int cap = b->capacity ? b->capacity * 2 : 64;
+        carom_contact_event *n = realloc(b->items, sizeof *n * (size_t)cap);
+        if (!n) return 0;
+        b->items = n;
+        b->capacity = cap;
+    }
+    b->items[b->count++] = *e;
+    return 1;
+}
+
+CAROM_API int carom_world_get_events(const carom_world *w, const carom_contact_event **events)
+{
+    if (!w || !events) return 0;
+    *events = w->events.items;
+    return w->events.count;
+}
+
+CAROM_API carom_status carom_world_get_stats(const carom_world *w, carom_world_stats *stats)
+{
+    if (!w || !stats) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (stats->size < sizeof(uint32_t)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "get_stats: size not set");
+    carom_world_stats s = w->stats;
+    s.bodies = w->bodies.count;
+    size_t sz = stats->size < sizeof s ? stats->size : sizeof s;
+    memcpy(stats, &s, sz);
+    stats->size = (uint32_t)sz;
+    return CAROM_OK;
+}
+
+/* ---- the step -------------------------------------------------------------- */
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static void run_deferred_destroys(carom_world *w)
+{
+    step_scratch *s = &w->scratch;
+    for (int i = 0; i < s->deferred_count; i++) {
+        int id = s->deferred_destroy[i];
+        carom_body_id bid = world_make_id(w, id);
+        if (carom_body_is_valid(w, bid)) carom_body_destroy(w, bid);
+    }
+    s->deferred_count = 0;
+}
+
+CAROM_API carom_status carom_world_step(carom_world *w, double dt)
+{
+    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "step: world is locked (called from a callback?)");
+    if (!isfinite(dt) || dt <= 0 || dt > 1.0)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "step: dt must be in (0, 1] seconds (got %g)", dt);
+    double t0 = now_ms();
+    w->locked = 1;
+    w->last_dt = dt;
+    w->events.count = 0;
+    w->stats.clamped = 0;
+    w->stats.toi_events = 0;
+
+    double t1 = now_ms();
+    world_update_pairs(w);
+    double t2 = now_ms();
+    world_collide(w);
+    double t3 = now_ms();
+    int ok = world_solve(w, dt);
+    double t4 = now_ms();
+    if (w->def.enable_continuous) world_continuous(w, dt);
+    double t5 = now_ms();
+    world_update_sleep(w, dt);
+    double t6 = now_ms();
+
+    w->stats.ms_broadphase = t2 - t1;
+    w->stats.ms_narrowphase = t3 - t2;
+    w->stats.ms_solver = t4 - t3;
+    w->stats.ms_continuous = t5 - t4;
+    w->stats.ms_islands = t6 - t5;
+    w->stats.step_count++;
+
+    if (w->def.event_callback) {
+        w->in_callback = 1;
+        for (int i = 0; i < w->events.count; i++) w->def.event_callback(w->def.event_context, &w->events.items[i]);
+        w->in_callback = 0;
+    }
+    w->locked = 0;
+    run_deferred_destroys(w);
+    w->stats.ms_total = now_ms() - t0;
+    if (!ok) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "step: out of memory (the step was not solved)");
+    return CAROM_OK;
+}

@@ -1,0 +1,73 @@
+/* world.h - the world: settings, body store, broadphase, contacts, events,
+ * stats. Internal; the public face is include/carom/carom.h. */
+#ifndef CAROM_WORLD_H
+#define CAROM_WORLD_H
+
+#include "carom/carom.h"
+#include "body.h"
+#include "broadphase.h"
+#include "contact.h"
+#include "impulse.h"
+
+#define WORLD_ERROR_SIZE 256
+
+typedef struct event_buffer {
+    carom_contact_event *items;
+    int count, capacity;
+} event_buffer;
+
+/* Scratch arrays reused every step (never freed between steps). */
+typedef struct step_scratch {
+    impulse_body *bodies;       /* solver bodies: index 0 is the shared static body */
+    vec3 *delta_position;       /* per solver body, since the start of the step */
+    vec3 *delta_rotation;       /* accumulated rotation vector (small-angle) */
+    int *body_slot;             /* solver body -> store slot */
+    int body_capacity;
+    void *constraints;          /* solver.c's constraint arrays */
+    int constraint_capacity;
+    int *island_parent;         /* union-find over id indices */
+    int island_capacity;
+    int *deferred_destroy;      /* id indices destroyed from callbacks */
+    int deferred_count, deferred_capacity;
+    vec3 *start_center;         /* continuous collision: pose at step start */
+    quat *start_rotation;
+    int start_capacity;
+} step_scratch;
+
+struct carom_world {
+    carom_world_def def;
+    body_store bodies;
+    broadphase *bp;
+    contact_set contacts;
+    event_buffer events;
+    step_scratch scratch;
+    carom_world_stats stats;
+    int locked;                 /* inside step or a callback */
+    int in_callback;
+    double last_dt;
+    char error[WORLD_ERROR_SIZE];
+};
+
+/* Records a formatted error on the world; returns status for chaining. */
+carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* Fattened bounds used by the broadphase for a body at its current pose. */
+aabb world_body_fat_aabb(const carom_world *w, int slot, double margin);
+/* Wakes the body (and, through contacts, its island on the next step). */
+void world_wake_body(carom_world *w, int slot);
+/* Removes every contact of a body (id index), emitting end events. */
+void world_remove_body_contacts(carom_world *w, int id_index);
+int world_push_event(carom_world *w, const carom_contact_event *e);
+carom_body_id world_make_id(const carom_world *w, int id_index);
+
+/* Stages of the step, one file each. */
+void world_update_pairs(carom_world *w);               /* broadphase.c users: collide.c */
+void world_collide(carom_world *w);                    /* narrowphase over contacts */
+int world_solve(carom_world *w, double dt);            /* solver.c (0 on out of memory) */
+void world_update_sleep(carom_world *w, double dt);    /* island.c */
+void world_continuous(carom_world *w, double dt);      /* toi.c */
+
+#endif
