@@ -76,7 +76,7 @@ $(BUILD)/tests/%: tests/%.c $(STATIC) $(wildcard tests/*.h) | $(BUILD)/tests
 	$(CC) $(CFLAGS_ALL) -Wno-unused-parameter $< -o $@ $(STATIC) $(CMOCKA_LIBS) $(LDLIBS_ALL) $(SANLD)
 
 $(BUILD)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h) | $(BUILD)/bench
-	$(CC) $(CFLAGS_ALL) -Ishared-peers $< -o $@ $(STATIC) $(LDLIBS_ALL) $(SANLD)
+	$(CC) $(CFLAGS_ALL) -Wno-unused-function -Ibench $< -o $@ $(STATIC) $(LDLIBS_ALL) $(SANLD)
 
 # The Lua module and the runner (the runner links the module in, so it runs
 # under the sanitizers without preloading anything into the system lua).

@@ -111,3 +111,20 @@ CAROM_API int carom_world_query_aabb(const carom_world *w, carom_vec3 lo, carom_
     bp_query(w->bp, q.box, box_visit, &q);
     return q.count;
 }
+
+CAROM_API double carom_world_measure_max_penetration(const carom_world *w)
+{
+    if (!w) return 0.0;
+    const body_store *s = &w->bodies;
+    double deepest = 0.0;
+    for (int i = 0; i < w->contacts.count; i++) {
+        const contact *c = &w->contacts.items[i];
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        collide_cache cache = c->cache; /* a copy: measuring must not change the world */
+        manifold m;
+        collide(&s->shapes[a], body_xform(s, a), &s->shapes[b], body_xform(s, b), 0.0, &cache, &m);
+        for (int j = 0; j < m.count; j++)
+            if (-m.points[j].separation > deepest) deepest = -m.points[j].separation;
+    }
+    return deepest;
+}

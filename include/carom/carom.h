@@ -411,6 +411,10 @@ CAROM_API carom_status carom_world_get_energy(const carom_world *world, double *
 /* Linear momentum and angular momentum about the world origin of the dynamic bodies. */
 CAROM_API carom_status carom_world_get_momentum(const carom_world *world, carom_vec3 *linear, carom_vec3 *angular);
 
+/* Deepest overlap of any pair at the bodies' current poses: an extra
+ * narrowphase pass over the cached pairs (not the last step's measurement). */
+CAROM_API double carom_world_measure_max_penetration(const carom_world *world);
+
 typedef struct carom_ray_hit {
     carom_body_id body;
     carom_vec3 point;

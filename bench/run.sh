@@ -1,0 +1,26 @@
+#!/bin/sh
+# make bench: carom beside ODE and Bullet on the canonical scenes (same run,
+# interleaved), then the broadphase scaling benchmark. Results go to bench/out/.
+set -eu
+cd "$(dirname "$0")"
+mkdir -p out
+RUNS=${RUNS:-3}
+if ! pkg-config --exists ode bullet 2>/dev/null; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "bench: installing the peers (libode-dev libbullet-dev)" >&2
+        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libode-dev libbullet-dev g++ >/dev/null
+    else
+        echo "bench: ODE/Bullet not installed (apt-get install libode-dev libbullet-dev); peers skipped" >&2
+    fi
+fi
+echo "== canonical scenes: carom vs ODE vs Bullet (RUNS=$RUNS, median ms/step)"
+if pkg-config --exists ode bullet 2>/dev/null; then
+    make -s -C peers all
+else
+    mkdir -p peers/build && cp ../build/bench/bench_carom peers/build/
+fi
+RUNS=$RUNS ./peers/run.sh | tee out/peers.txt
+cp peers/build/raw.txt out/peers_raw.txt
+echo
+echo "== broadphase pair finding"
+../build/bench/bench_broadphase | tee out/broadphase.txt

@@ -1,0 +1,498 @@
+/* test_solver.c - the world step against analytic answers: bounce height,
+ * stopping distance, incline statics and sliding, rolling transition, energy
+ * of an elastic gas, stacks, pyramid, a 1000:1 mass ratio, a 750 m/s bullet,
+ * sleeping and hit events. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+#include "carom/carom.h"
+#include "world.h"
+
+#define G 9.81
+#define DT (1.0 / 60.0)
+#define PI_ 3.14159265358979323846
+
+static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
+
+static carom_world *world_with(carom_world_def d, int ground, double ground_mu, double ground_e)
+{
+    carom_world *w = carom_world_create(&d);
+    assert_non_null(w);
+    if (ground) {
+        carom_body_def g = carom_body_def_default();
+        g.type = CAROM_BODY_STATIC;
+        g.shape = carom_shape_plane(0, 0, 1, 0);
+        g.friction = ground_mu;
+        g.restitution = ground_e;
+        assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    }
+    return w;
+}
+
+static carom_body_id add_box(carom_world *w, double x, double y, double z, double he, double mass, double mu)
+{
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(x, y, z);
+    d.shape = carom_shape_box(he, he, he);
+    d.mass = mass;
+    d.friction = mu;
+    carom_body_id id = carom_body_create(w, &d);
+    assert_false(carom_body_id_is_null(id));
+    return id;
+}
+
+static carom_vec3 pos(carom_world *w, carom_body_id id)
+{
+    carom_vec3 p;
+    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
+    return p;
+}
+
+static carom_vec3 vel(carom_world *w, carom_body_id id)
+{
+    carom_vec3 v;
+    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
+    return v;
+}
+
+static void step_n(carom_world *w, int n, double dt)
+{
+    for (int i = 0; i < n; i++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+}
+
+#define EXPECT_NEAR(got, want, tol, what)                                                          \
+    do {                                                                                           \
+        double g_ = (got), w_ = (want);                                                           \
+        if (!(fabs(g_ - w_) <= (tol))) {                                                          \
+            print_error("%s: got %.6f, expected %.6f (tolerance %.6f)\n", (what), g_, w_, (double)(tol)); \
+            fail();                                                                                \
+        }                                                                                          \
+    } while (0)
+
+/* e = 0.5 from 1 m: the first rebound rises e^2 h = 0.25 m. */
+static void test_bounce_height(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 1, 0.0, 0.0);
+    carom_body_def d = carom_body_def_default();
+    double r = 0.1;
+    d.position = vec(0, 0, 1.0 + r);
+    d.shape = carom_shape_sphere(r);
+    d.restitution = 0.5;
+    d.friction = 0.0;
+    carom_body_id ball = carom_body_create(w, &d);
+    int bounced = 0;
+    double apex = 0;
+    for (int i = 0; i < 240; i++) {
+        step_n(w, 1, DT);
+        carom_vec3 v = vel(w, ball), p = pos(w, ball);
+        if (v.z > 0) bounced = 1;
+        if (bounced) {
+            if (p.z - r > apex) apex = p.z - r;
+            if (v.z < 0) break;
+        }
+    }
+    assert_true(bounced);
+    EXPECT_NEAR(apex, 0.25, 0.02 * 0.25, "rebound apex");
+    carom_world_destroy(w);
+}
+
+/* A box sliding at 5 m/s with mu 0.5 stops after v^2 / (2 mu g) = 2.548 m, flat. */
+static void test_sliding_stop_distance(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 1, 0.5, 0.0);
+    carom_body_id box = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.5);
+    step_n(w, 10, DT); /* settle onto the ground */
+    carom_vec3 p0 = pos(w, box);
+    assert_int_equal(carom_body_set_linear_velocity(w, box, vec(5, 0, 0)), CAROM_OK);
+    step_n(w, 180, DT);
+    carom_vec3 p1 = pos(w, box), v = vel(w, box);
+    double expected = 25.0 / (2 * 0.5 * G);
+    EXPECT_NEAR(p1.x - p0.x, expected, 0.03 * expected, "stopping distance");
+    assert_true(fabs(v.x) < 1e-3);
+    carom_quat q;
+    carom_body_get_orientation(w, box, &q);
+    assert_true(fabs(q.w) > 0.9999); /* did not tip */
+    EXPECT_NEAR(p1.z, 0.5, 0.01, "height while sliding");
+    carom_world_destroy(w);
+}
+
+/* Box on a plane inclined by `deg`; returns displacement along the slope after t seconds. */
+static double incline_run(double deg, double t, double *lateral)
+{
+    double a = deg * PI_ / 180.0;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    /* slope rising towards -x: normal (sin a, 0, cos a) */
+    g.shape = carom_shape_plane(sin(a), 0, cos(a), 0);
+    g.friction = 0.5;
+    carom_body_create(w, &g);
+    carom_body_def d = carom_body_def_default();
+    carom_vec3 n = vec(sin(a), 0, cos(a));
+    d.position = vec(0.5 * n.x, 0, 0.5 * n.z);
+    carom_quat q = {cos(0.5 * a), 0, sin(0.5 * a), 0}; /* rotate about +y by a */
+    d.orientation = q;
+    d.shape = carom_shape_box(0.5, 0.5, 0.5);
+    d.mass = 1.0;
+    d.friction = 0.5;
+    d.enable_sleep = 0;
+    carom_body_id box = carom_body_create(w, &d);
+    step_n(w, 30, DT); /* settle: contact forms at rest */
+    carom_vec3 p0 = pos(w, box);
+    step_n(w, (int)lround(t / DT), DT);
+    carom_vec3 p1 = pos(w, box);
+    /* down-slope direction: (cos a, 0, -sin a) */
+    double along = (p1.x - p0.x) * cos(a) - (p1.z - p0.z) * sin(a);
+    if (lateral) *lateral = fabs(p1.y - p0.y);
+    carom_world_destroy(w);
+    return along;
+}
+
+static void test_incline_static_friction(void **state)
+{
+    (void)state;
+    double lateral;
+    double moved = incline_run(20.0, 5.0, &lateral);
+    if (!(fabs(moved) < 1e-3)) { print_error("moved %.6f m on a 20 degree slope\n", moved); fail(); }
+}
+
+static void test_incline_sliding_acceleration(void **state)
+{
+    (void)state;
+    double a = 35.0 * PI_ / 180.0, t = 2.0;
+    double expected_acc = G * (sin(a) - 0.5 * cos(a)); /* 1.609 m/s^2 */
+    double d = incline_run(35.0, t, NULL);
+    /* the box starts from rest after settling: d = a t^2 / 2 */
+    double acc = 2.0 * d / (t * t);
+    EXPECT_NEAR(acc, expected_acc, 0.03 * expected_acc, "sliding acceleration");
+}
+
+/* A sphere launched without spin ends rolling at 5/7 of its speed. */
+static void test_rolling_transition(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 1, 0.4, 0.0);
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(0, 0, 0.25);
+    d.shape = carom_shape_sphere(0.25);
+    d.mass = 1.0;
+    d.friction = 0.4;
+    d.linear_velocity = vec(5, 0, 0);
+    d.enable_sleep = 0;
+    carom_body_id ball = carom_body_create(w, &d);
+    step_n(w, 120, DT);
+    carom_vec3 v = vel(w, ball), av;
+    carom_body_get_angular_velocity(w, ball, &av);
+    EXPECT_NEAR(v.x, 5.0 * 5.0 / 7.0, 0.02 * 5.0 * 5.0 / 7.0, "rolling speed");
+    EXPECT_NEAR(av.y * 0.25, v.x, 1e-3, "rolling without slip (w r = v)");
+    carom_world_destroy(w);
+}
+
+/* Frictionless elastic spheres in a closed box without gravity keep their energy. */
+static void test_elastic_gas_energy(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.gravity = vec(0, 0, 0);
+    wd.restitution_threshold = 0.0;
+    wd.enable_friction = 0;
+    wd.enable_sleep = 0;
+    carom_world *w = carom_world_create(&wd);
+    const double L = 3.0;
+    double walls[6][4] = {{0, 0, 1, -L}, {0, 0, -1, -L}, {1, 0, 0, -L}, {-1, 0, 0, -L}, {0, 1, 0, -L}, {0, -1, 0, -L}};
+    for (int i = 0; i < 6; i++) {
+        carom_body_def g = carom_body_def_default();
+        g.type = CAROM_BODY_STATIC;
+        g.shape = carom_shape_plane(walls[i][0], walls[i][1], walls[i][2], walls[i][3]);
+        g.restitution = 1.0;
+        g.friction = 0.0;
+        carom_body_create(w, &g);
+    }
+    uint32_t rng = 7u;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            for (int k = 0; k < 4; k++) {
+                carom_body_def d = carom_body_def_default();
+                d.position = vec(-2.25 + 1.5 * i, -2.25 + 1.5 * j, -2.25 + 1.5 * k);
+                d.shape = carom_shape_sphere(0.3);
+                d.restitution = 1.0;
+                d.friction = 0.0;
+                double v[3];
+                for (int c = 0; c < 3; c++) {
+                    rng = rng * 1664525u + 1013904223u;
+                    v[c] = 4.0 * ((double)(rng >> 8) / 16777216.0 - 0.5);
+                }
+                d.linear_velocity = vec(v[0], v[1], v[2]);
+                carom_body_create(w, &d);
+            }
+    double ke0, ke1, pe;
+    carom_world_get_energy(w, &ke0, &pe);
+    step_n(w, 600, DT);
+    carom_world_get_energy(w, &ke1, &pe);
+    EXPECT_NEAR(ke1 / ke0, 1.0, 0.01, "kinetic energy ratio after 10 s");
+    carom_world_destroy(w);
+}
+
+static void test_stack_of_ten(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    carom_world *w = world_with(wd, 1, 0.6, 0.0);
+    carom_body_id box[10];
+    for (int i = 0; i < 10; i++) box[i] = add_box(w, 0, 0, 0.5 + i, 0.5, 1.0, 0.6);
+    step_n(w, 600, DT);
+    carom_vec3 p = pos(w, box[9]);
+    double moved = sqrt(p.x * p.x + p.y * p.y + (p.z - 9.5) * (p.z - 9.5));
+    if (!(moved < 0.01)) { print_error("top box moved %.4f m\n", moved); fail(); }
+    carom_world_destroy(w);
+}
+
+static void test_pyramid_stands(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    carom_world *w = world_with(wd, 1, 0.6, 0.0);
+    carom_body_id ids[210];
+    double start[210][3];
+    int k = 0;
+    for (int r = 0; r < 20; r++)
+        for (int i = 0; i < 20 - r; i++) {
+            start[k][0] = (i - 0.5 * (20 - r - 1));
+            start[k][1] = 0;
+            start[k][2] = 0.5 + r;
+            ids[k] = add_box(w, start[k][0], 0, start[k][2], 0.5, 1.0, 0.6);
+            k++;
+        }
+    step_n(w, 600, DT);
+    double maxd = 0;
+    for (int i = 0; i < k; i++) {
+        carom_vec3 p = pos(w, ids[i]);
+        double d = sqrt(pow(p.x - start[i][0], 2) + pow(p.y, 2) + pow(p.z - start[i][2], 2));
+        if (d > maxd) maxd = d;
+    }
+    if (!(maxd < 0.05)) { print_error("pyramid max displacement %.4f m\n", maxd); fail(); }
+    carom_world_destroy(w);
+}
+
+static void test_mass_ratio_holds(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    carom_world *w = world_with(wd, 1, 0.6, 0.0);
+    carom_body_id light = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.6);
+    carom_body_id heavy = add_box(w, 0, 0, 1.5, 0.5, 1000.0, 0.6);
+    step_n(w, 600, DT);
+    carom_vec3 ph = pos(w, heavy), pl = pos(w, light);
+    EXPECT_NEAR(ph.z, 1.5, 0.01, "heavy box height");
+    EXPECT_NEAR(pl.z, 0.5, 0.01, "light box height");
+    assert_true(hypot(ph.x - pl.x, ph.y - pl.y) < 0.01);
+    carom_world_destroy(w);
+}
+
+/* The peers' bullet: 1 cm, 10 g sphere at 750 m/s against a 5 cm wall. */
+static void test_bullet_does_not_tunnel(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.5, 0.0);
+    carom_body_def wall = carom_body_def_default();
+    wall.type = CAROM_BODY_STATIC;
+    wall.position = vec(1.025, 0, 2.0);
+    wall.shape = carom_shape_box(0.025, 2.0, 2.0);
+    wall.friction = 0.5;
+    carom_body_create(w, &wall);
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(0, 0, 2.0);
+    d.shape = carom_shape_sphere(0.01);
+    d.mass = 0.01;
+    d.friction = 0.5;
+    d.linear_velocity = vec(750, 0, 0);
+    d.bullet = 1;
+    carom_body_id b = carom_body_create(w, &d);
+    int hits = 0;
+    for (int i = 0; i < 60; i++) {
+        step_n(w, 1, DT);
+        const carom_contact_event *ev;
+        int n = carom_world_get_events(w, &ev);
+        for (int j = 0; j < n; j++)
+            if (ev[j].type == CAROM_EVENT_HIT) {
+                hits++;
+                /* the wall stops it: J = m v, average force J / dt */
+                EXPECT_NEAR(ev[j].normal_impulse, 0.01 * 750.0, 0.01 * 7.5, "bullet impulse");
+                EXPECT_NEAR(ev[j].average_force, ev[j].normal_impulse / DT, 1e-9, "average force");
+            }
+        assert_true(pos(w, b).x < 1.0);
+    }
+    assert_int_equal(hits, 1);
+    carom_world_destroy(w);
+}
+
+/* The same without continuous collision: the fast path must be what saves it. */
+static void test_bullet_tunnels_without_ccd(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_continuous = 0;
+    carom_world *w = world_with(wd, 0, 0.5, 0.0);
+    carom_body_def wall = carom_body_def_default();
+    wall.type = CAROM_BODY_STATIC;
+    wall.position = vec(1.025, 0, 2.0);
+    wall.shape = carom_shape_box(0.025, 2.0, 2.0);
+    carom_body_create(w, &wall);
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(-20, 0, 2.0);
+    d.shape = carom_shape_sphere(0.01);
+    d.mass = 0.01;
+    d.linear_velocity = vec(750, 0, 0);
+    carom_body_id b = carom_body_create(w, &d);
+    step_n(w, 60, DT);
+    assert_true(pos(w, b).x > 1.05);
+    carom_world_destroy(w);
+}
+
+/* Resting boxes keep the same 4 contact features for 600 steps. */
+static void test_feature_ids_stable(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    carom_world *w = world_with(wd, 1, 0.6, 0.0);
+    carom_body_id lower = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.6);
+    carom_body_id upper = add_box(w, 0, 0, 1.5, 0.5, 1.0, 0.6);
+    step_n(w, 5, DT);
+    int ia = (int)lower.index1 - 1, ib = (int)upper.index1 - 1;
+    int ci = contact_find(&w->contacts, ia, ib);
+    assert_true(ci >= 0);
+    uint32_t ids[4];
+    assert_int_equal(w->contacts.items[ci].m.count, 4);
+    for (int j = 0; j < 4; j++) ids[j] = w->contacts.items[ci].m.points[j].id;
+    for (int s = 0; s < 600; s++) {
+        step_n(w, 1, DT);
+        ci = contact_find(&w->contacts, ia, ib);
+        assert_true(ci >= 0);
+        const manifold *m = &w->contacts.items[ci].m;
+        assert_int_equal(m->count, 4);
+        for (int j = 0; j < 4; j++) assert_int_equal(m->points[j].id, ids[j]);
+    }
+    carom_world_destroy(w);
+}
+
+static void test_sleep_and_wake(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 1, 0.6, 0.0);
+    carom_body_id box = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.6);
+    step_n(w, 120, DT);
+    assert_false(carom_body_is_awake(w, box));
+    carom_world_stats st = carom_world_stats_init();
+    carom_world_get_stats(w, &st);
+    assert_int_equal(st.awake_bodies, 0);
+    /* a falling box wakes it on impact */
+    carom_body_id dropper = add_box(w, 0, 0, 3.0, 0.5, 1.0, 0.6);
+    int woke = 0;
+    for (int i = 0; i < 60; i++) {
+        step_n(w, 1, DT);
+        if (carom_body_is_awake(w, box)) woke = 1;
+    }
+    assert_true(woke);
+    EXPECT_NEAR(pos(w, dropper).z, 1.5, 0.02, "dropped box rests on the first");
+    /* setting a velocity wakes a sleeper */
+    step_n(w, 120, DT);
+    assert_false(carom_body_is_awake(w, dropper));
+    carom_body_set_linear_velocity(w, dropper, vec(0, 0, 1));
+    assert_true(carom_body_is_awake(w, dropper));
+    carom_world_destroy(w);
+}
+
+/* A particle (rotation locked) and a planar body stay within their constraints. */
+static void test_locks(void **state)
+{
+    (void)state;
+    carom_world *w = world_with(carom_world_def_default(), 1, 0.6, 0.0);
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(0, 0, 0.5);
+    d.shape = carom_shape_box(0.5, 0.5, 0.5);
+    d.lock_rotation = 1;
+    d.angular_velocity = vec(3, 1, 2);
+    carom_body_id p = carom_body_create(w, &d);
+    carom_body_def e = carom_body_def_default();
+    e.position = vec(3, 0, 2);
+    e.shape = carom_shape_sphere(0.5);
+    e.lock_to_plane = 1;
+    e.linear_velocity = vec(1, 5, 0);
+    carom_body_id q = carom_body_create(w, &e);
+    carom_vec3 im = {0, 2, 0}, at = {3, 0.3, 2.4};
+    carom_body_apply_impulse(w, q, im, &at);
+    step_n(w, 120, DT);
+    carom_vec3 av;
+    carom_body_get_angular_velocity(w, p, &av);
+    assert_true(av.x == 0 && av.y == 0 && av.z == 0);
+    carom_quat o;
+    carom_body_get_orientation(w, p, &o);
+    assert_true(o.w == 1.0);
+    carom_vec3 pq = pos(w, q), vq = vel(w, q);
+    assert_true(fabs(pq.y) < 1e-9 && fabs(vq.y) < 1e-9);
+    carom_world_destroy(w);
+}
+
+static void test_momentum_conserved_in_free_collisions(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.gravity = vec(0, 0, 0);
+    carom_world *w = carom_world_create(&wd);
+    carom_body_def a = carom_body_def_default();
+    a.shape = carom_shape_box(0.5, 0.3, 0.2);
+    a.mass = 3.0;
+    a.position = vec(-2, 0.2, 0.1);
+    a.linear_velocity = vec(4, 0, 0);
+    a.angular_velocity = vec(0.5, 1, 2);
+    carom_body_create(w, &a);
+    carom_body_def b = carom_body_def_default();
+    b.shape = carom_shape_capsule(0.3, 0.4);
+    b.mass = 0.7;
+    b.position = vec(1, 0, 0);
+    b.linear_velocity = vec(-3, 0.5, 0);
+    carom_body_create(w, &b);
+    carom_vec3 p0, l0, p1, l1;
+    carom_world_get_momentum(w, &p0, &l0);
+    step_n(w, 120, DT);
+    carom_world_get_momentum(w, &p1, &l1);
+    assert_true(fabs(p1.x - p0.x) < 1e-9 && fabs(p1.y - p0.y) < 1e-9 && fabs(p1.z - p0.z) < 1e-9);
+    EXPECT_NEAR(l1.x, l0.x, 1e-6 * (1 + fabs(l0.x)), "angular momentum x");
+    EXPECT_NEAR(l1.y, l0.y, 1e-6 * (1 + fabs(l0.y)), "angular momentum y");
+    EXPECT_NEAR(l1.z, l0.z, 1e-6 * (1 + fabs(l0.z)), "angular momentum z");
+    carom_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bounce_height),
+        cmocka_unit_test(test_sliding_stop_distance),
+        cmocka_unit_test(test_incline_static_friction),
+        cmocka_unit_test(test_incline_sliding_acceleration),
+        cmocka_unit_test(test_rolling_transition),
+        cmocka_unit_test(test_elastic_gas_energy),
+        cmocka_unit_test(test_stack_of_ten),
+        cmocka_unit_test(test_pyramid_stands),
+        cmocka_unit_test(test_mass_ratio_holds),
+        cmocka_unit_test(test_bullet_does_not_tunnel),
+        cmocka_unit_test(test_bullet_tunnels_without_ccd),
+        cmocka_unit_test(test_feature_ids_stable),
+        cmocka_unit_test(test_sleep_and_wake),
+        cmocka_unit_test(test_locks),
+        cmocka_unit_test(test_momentum_conserved_in_free_collisions),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
