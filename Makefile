@@ -89,8 +89,10 @@ $(RUNNER): lua/carom-run.c $(LUA_SRC) $(STATIC) $(wildcard lua/*.h)
 
 # ---- tests ----------------------------------------------------------------
 check: deps
+	$(MAKE) --no-print-directory all
 	$(MAKE) --no-print-directory check-c
 	$(MAKE) --no-print-directory check-lua
+	./tests/install_test.sh
 	$(MAKE) --no-print-directory SAN=1 check-c
 	$(MAKE) --no-print-directory SAN=1 check-lua
 	@echo "make check: all tests passed"
