@@ -12,6 +12,7 @@
 #include <string.h>
 #include "carom/carom.h"
 #include "peers/scenes.h"
+#include "scenes_extra.h"
 
 static void run_scene(SceneDesc *sc)
 {
@@ -29,36 +30,9 @@ static void run_scene(SceneDesc *sc)
     carom_world *w = carom_world_create(&wd);
     if (!w) { fprintf(stderr, "bad world settings\n"); exit(2); }
     sc->ccd_supported = 1;
-    if (sc->ground) {
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.shape = carom_shape_plane(0, 0, 1, 0);
-        g.friction = sc->mu;
-        carom_body_create(w, &g);
-    }
-    for (int i = 0; i < sc->nstatic; i++) {
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.position.x = sc->statics[i].pos[0];
-        g.position.y = sc->statics[i].pos[1];
-        g.position.z = sc->statics[i].pos[2];
-        g.shape = carom_shape_box(sc->statics[i].half[0], sc->statics[i].half[1], sc->statics[i].half[2]);
-        g.friction = sc->mu;
-        carom_body_create(w, &g);
-    }
     carom_body_id *ids = malloc(sizeof *ids * (size_t)sc->nbodies);
     BodyFinal *fin = calloc((size_t)sc->nbodies, sizeof *fin);
-    for (int i = 0; i < sc->nbodies; i++) {
-        const BodyDesc *b = &sc->bodies[i];
-        carom_body_def d = carom_body_def_default();
-        d.position.x = b->pos[0]; d.position.y = b->pos[1]; d.position.z = b->pos[2];
-        d.linear_velocity.x = b->vel[0]; d.linear_velocity.y = b->vel[1]; d.linear_velocity.z = b->vel[2];
-        d.shape = b->shape == SHAPE_BOX ? carom_shape_box(b->he, b->he, b->he) : carom_shape_sphere(b->he);
-        d.mass = b->mass;
-        d.friction = sc->mu;
-        d.bullet = sc->id == SC_BULLET && sc->ccd;
-        ids[i] = carom_body_create(w, &d);
-    }
+    canonical_build(w, sc, ids);
     double t0 = bench_now_ms();
     for (int s = 0; s < sc->steps; s++) carom_world_step(w, BENCH_DT);
     double t1 = bench_now_ms();
