@@ -1,0 +1,217 @@
+/* test_extremes.c - numerical stability at the edges of the envelope (fast
+ * versions; bench/extremes runs the long ones): mass ratios, speeds, sizes,
+ * distance from the origin, time steps, and a soak. The state must stay
+ * finite everywhere, and accurate where the README says carom holds. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+#include "carom/carom.h"
+
+static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
+
+static carom_world *ground_world(carom_world_def d)
+{
+    d.enable_sleep = 0;
+    carom_world *w = carom_world_create(&d);
+    assert_non_null(w);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(w, &g);
+    return w;
+}
+
+static carom_body_id box_at(carom_world *w, double x, double y, double z, double he, double mass)
+{
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(x, y, z);
+    d.shape = carom_shape_box(he, he, he);
+    d.mass = mass;
+    carom_body_id id = carom_body_create(w, &d);
+    assert_false(carom_body_id_is_null(id));
+    return id;
+}
+
+static carom_vec3 pos(carom_world *w, carom_body_id id)
+{
+    carom_vec3 p;
+    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
+    return p;
+}
+
+static void assert_world_finite(carom_world *w)
+{
+    double ke, pe;
+    carom_vec3 p, l;
+    assert_int_equal(carom_world_get_energy(w, &ke, &pe), CAROM_OK);
+    assert_int_equal(carom_world_get_momentum(w, &p, &l), CAROM_OK);
+    assert_true(isfinite(ke) && isfinite(pe));
+    assert_true(isfinite(p.x) && isfinite(p.y) && isfinite(p.z) && isfinite(l.x) && isfinite(l.y) && isfinite(l.z));
+}
+
+static void run(carom_world *w, int n, double dt)
+{
+    for (int i = 0; i < n; i++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+}
+
+/* 1000:1 holds; 1e6:1 stays finite and upright-ish (the light box is not squeezed out). */
+static void test_mass_ratios(void **state)
+{
+    (void)state;
+    double ratios[2] = {1e3, 1e6};
+    for (int i = 0; i < 2; i++) {
+        carom_world *w = ground_world(carom_world_def_default());
+        carom_body_id light = box_at(w, 0, 0, 0.5, 0.5, 1.0);
+        carom_body_id heavy = box_at(w, 0, 0, 1.5, 0.5, ratios[i]);
+        run(w, 300, 1.0 / 60);
+        assert_world_finite(w);
+        carom_vec3 ph = pos(w, heavy), pl = pos(w, light);
+        double tol = i == 0 ? 0.01 : 0.05;
+        if (!(fabs(ph.z - 1.5) < tol && fabs(pl.z - 0.5) < tol)) {
+            print_error("ratio %g: heavy z %.4f light z %.4f\n", ratios[i], ph.z, pl.z);
+            fail();
+        }
+        carom_world_destroy(w);
+    }
+}
+
+/* Projectiles up to 1000 m/s against a 5 cm wall never pass through. */
+static void test_speeds(void **state)
+{
+    (void)state;
+    double speeds[4] = {10, 100, 500, 1000};
+    for (int i = 0; i < 4; i++) {
+        carom_world_def d = carom_world_def_default();
+        carom_world *w = carom_world_create(&d);
+        carom_body_def wall = carom_body_def_default();
+        wall.type = CAROM_BODY_STATIC;
+        wall.position = vec(1.025, 0, 2);
+        wall.shape = carom_shape_box(0.025, 2, 2);
+        carom_body_create(w, &wall);
+        carom_body_def s = carom_body_def_default();
+        s.position = vec(0, 0, 2);
+        s.shape = carom_shape_sphere(0.01);
+        s.mass = 0.01;
+        s.linear_velocity = vec(speeds[i], 0, 0);
+        carom_body_id b = carom_body_create(w, &s);
+        for (int k = 0; k < 60; k++) {
+            run(w, 1, 1.0 / 60);
+            if (!(pos(w, b).x < 1.0)) {
+                print_error("speed %g m/s: x = %.4f after step %d\n", speeds[i], pos(w, b).x, k);
+                fail();
+            }
+        }
+        assert_world_finite(w);
+        carom_world_destroy(w);
+    }
+}
+
+/* A box resting on the ground stays put from 1 mm to 1 km. */
+static void test_sizes(void **state)
+{
+    (void)state;
+    double sizes[4] = {0.001, 0.01, 100.0, 1000.0};
+    for (int i = 0; i < 4; i++) {
+        carom_world *w = ground_world(carom_world_def_default());
+        double he = 0.5 * sizes[i];
+        carom_body_id b = box_at(w, 0, 0, he, he, 1000.0 * sizes[i] * sizes[i] * sizes[i]);
+        run(w, 120, 1.0 / 60);
+        assert_world_finite(w);
+        carom_vec3 p = pos(w, b);
+        /* within 1 % of its size, or the 5 mm slop, whichever is larger */
+        double tol = fmax(0.01 * sizes[i], 0.006);
+        if (!(fabs(p.z - he) < tol && fabs(p.x) < tol && fabs(p.y) < tol)) {
+            print_error("size %g m: rest at (%.6f %.6f %.6f), expected z %.6f\n", sizes[i], p.x, p.y, p.z, he);
+            fail();
+        }
+        carom_world_destroy(w);
+    }
+}
+
+/* A five-box stack 1e5 m from the origin stands as it does at the origin. */
+static void test_far_from_origin(void **state)
+{
+    (void)state;
+    carom_world *w = ground_world(carom_world_def_default());
+    const double X = 1e5, Y = -1e5;
+    carom_body_id top = box_at(w, X, Y, 0.5, 0.5, 1);
+    for (int i = 1; i < 5; i++) top = box_at(w, X, Y, 0.5 + i, 0.5, 1);
+    run(w, 300, 1.0 / 60);
+    assert_world_finite(w);
+    carom_vec3 p = pos(w, top);
+    double moved = sqrt(pow(p.x - X, 2) + pow(p.y - Y, 2) + pow(p.z - 4.5, 2));
+    if (!(moved < 0.01)) { print_error("far stack top moved %.4f m\n", moved); fail(); }
+    carom_world_destroy(w);
+}
+
+/* Time steps from 1/1000 to 1/15 s: a stack of five stands at each. */
+static void test_time_steps(void **state)
+{
+    (void)state;
+    double dts[4] = {1.0 / 1000, 1.0 / 120, 1.0 / 30, 1.0 / 15};
+    for (int i = 0; i < 4; i++) {
+        carom_world *w = ground_world(carom_world_def_default());
+        carom_body_id top = box_at(w, 0, 0, 0.5, 0.5, 1);
+        for (int k = 1; k < 5; k++) top = box_at(w, 0, 0, 0.5 + k, 0.5, 1);
+        int steps = (int)(3.0 / dts[i]);
+        run(w, steps, dts[i]);
+        assert_world_finite(w);
+        carom_vec3 p = pos(w, top);
+        double moved = sqrt(p.x * p.x + p.y * p.y + pow(p.z - 4.5, 2));
+        if (!(moved < 0.03)) { print_error("dt %g: stack top moved %.4f m\n", dts[i], moved); fail(); }
+        carom_world_destroy(w);
+    }
+}
+
+/* A short soak: a box and a ball bouncing around a closed room stay finite and inside. */
+static void test_soak(void **state)
+{
+    (void)state;
+    carom_world_def d = carom_world_def_default();
+    d.enable_sleep = 0;
+    carom_world *w = carom_world_create(&d);
+    double walls[6][4] = {{0, 0, 1, 0}, {0, 0, -1, -6}, {1, 0, 0, -3}, {-1, 0, 0, -3}, {0, 1, 0, -3}, {0, -1, 0, -3}};
+    for (int i = 0; i < 6; i++) {
+        carom_body_def g = carom_body_def_default();
+        g.type = CAROM_BODY_STATIC;
+        g.shape = carom_shape_plane(walls[i][0], walls[i][1], walls[i][2], walls[i][3]);
+        g.restitution = 0.9;
+        carom_body_create(w, &g);
+    }
+    carom_body_def b = carom_body_def_default();
+    b.position = vec(0, 0, 2);
+    b.shape = carom_shape_box(0.3, 0.2, 0.1);
+    b.linear_velocity = vec(7, -3, 5);
+    b.angular_velocity = vec(4, 9, -2);
+    b.restitution = 0.9;
+    carom_body_id box = carom_body_create(w, &b);
+    b.shape = carom_shape_sphere(0.2);
+    b.position = vec(1, 1, 3);
+    carom_body_id ball = carom_body_create(w, &b);
+    for (int i = 0; i < 20000; i++) {
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        if (i % 1000 == 0) assert_world_finite(w);
+    }
+    carom_vec3 p = pos(w, box), q = pos(w, ball);
+    assert_true(fabs(p.x) < 3 && fabs(p.y) < 3 && p.z > 0 && p.z < 6);
+    assert_true(fabs(q.x) < 3 && fabs(q.y) < 3 && q.z > 0 && q.z < 6);
+    carom_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mass_ratios),
+        cmocka_unit_test(test_speeds),
+        cmocka_unit_test(test_sizes),
+        cmocka_unit_test(test_far_from_origin),
+        cmocka_unit_test(test_time_steps),
+        cmocka_unit_test(test_soak),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
