@@ -1,0 +1,634 @@
+/* narrowphase.c - contact manifolds by pair type. Round pairs are analytic;
+ * boxes, hulls and cylinders (as 16-sided prisms) go through one exact
+ * separating-axis test over faces and edge pairs, then reference/incident
+ * face clipping; libccd (MPR on the true round cylinder) picks the reference
+ * face when a cylinder overlaps. The normal always points from a to b. */
+#include <string.h>
+#include <ccd/ccd.h>
+#include "manifold.h"
+
+#define POLY_MAX_V 256
+#define POLY_MAX_F 256
+#define POLY_MAX_FV 1024
+#define CYL_SIDES 16
+#define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
+#define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */
+
+/* A convex polytope in world space. */
+typedef struct poly {
+    int nv, nf, ne;
+    vec3 v[POLY_MAX_V];
+    vec3 fn[POLY_MAX_F];
+    double fd[POLY_MAX_F];
+    int ffirst[POLY_MAX_F], fcount[POLY_MAX_F];
+    int fv[POLY_MAX_FV];
+    int e[POLY_MAX_FV / 2][2];
+    vec3 center;
+} poly;
+
+/* ---- building polytopes ------------------------------------------------------- */
+
+static void poly_finish(poly *p)
+{
+    p->center = v3_zero();
+    for (int i = 0; i < p->nv; i++) p->center = v3_add(p->center, p->v[i]);
+    p->center = v3_scale(p->center, 1.0 / p->nv);
+    for (int f = 0; f < p->nf; f++) p->fd[f] = v3_dot(p->fn[f], p->v[p->fv[p->ffirst[f]]]);
+}
+
+static void poly_from_hull(poly *p, const hull *h, xform x)
+{
+    p->nv = h->vertex_count;
+    p->nf = h->face_count;
+    p->ne = h->edge_count;
+    for (int i = 0; i < h->vertex_count; i++) p->v[i] = xf_point(x, h->vertices[i]);
+    int k = 0;
+    for (int f = 0; f < h->face_count; f++) {
+        p->fn[f] = q_rotate(x.q, h->faces[f].normal);
+        p->ffirst[f] = k;
+        p->fcount[f] = h->faces[f].count;
+        for (int j = 0; j < h->faces[f].count; j++) p->fv[k++] = h->face_vertices[h->faces[f].first + j];
+    }
+    for (int i = 0; i < h->edge_count; i++) { p->e[i][0] = h->edges[i][0]; p->e[i][1] = h->edges[i][1]; }
+    poly_finish(p);
+}
+
+static void poly_from_box(poly *p, vec3 he, xform x)
+{
+    static const int faces[6][4] = {{1, 3, 7, 5}, {0, 4, 6, 2}, {2, 6, 7, 3}, {0, 1, 5, 4}, {4, 5, 7, 6}, {0, 2, 3, 1}};
+    static const double normals[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const int edges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    p->nv = 8; p->nf = 6; p->ne = 12;
+    for (int i = 0; i < 8; i++)
+        p->v[i] = xf_point(x, v3((i & 1) ? he.x : -he.x, (i & 2) ? he.y : -he.y, (i & 4) ? he.z : -he.z));
+    for (int f = 0; f < 6; f++) {
+        p->fn[f] = q_rotate(x.q, v3(normals[f][0], normals[f][1], normals[f][2]));
+        p->ffirst[f] = 4 * f;
+        p->fcount[f] = 4;
+        for (int j = 0; j < 4; j++) p->fv[4 * f + j] = faces[f][j];
+    }
+    for (int i = 0; i < 12; i++) { p->e[i][0] = edges[i][0]; p->e[i][1] = edges[i][1]; }
+    poly_finish(p);
+}
+
+/* A cylinder as a prism whose vertices lie on the true rims. */
+static void poly_from_cylinder(poly *p, double r, double hh, xform x)
+{
+    const int n = CYL_SIDES;
+    p->nv = 2 * n; p->nf = n + 2; p->ne = 3 * n;
+    for (int i = 0; i < n; i++) {
+        double a = 6.283185307179586 * i / n;
+        p->v[i] = xf_point(x, v3(r * cos(a), r * sin(a), -hh));
+        p->v[n + i] = xf_point(x, v3(r * cos(a), r * sin(a), hh));
+    }
+    int k = 0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        double a = 6.283185307179586 * (i + 0.5) / n;
+        p->fn[i] = q_rotate(x.q, v3(cos(a), sin(a), 0));
+        p->ffirst[i] = k;
+        p->fcount[i] = 4;
+        p->fv[k++] = i; p->fv[k++] = j; p->fv[k++] = n + j; p->fv[k++] = n + i;
+        p->e[i][0] = i; p->e[i][1] = j;
+        p->e[n + i][0] = n + i; p->e[n + i][1] = n + j;
+        p->e[2 * n + i][0] = i; p->e[2 * n + i][1] = n + i;
+    }
+    p->fn[n] = q_rotate(x.q, v3(0, 0, 1));
+    p->ffirst[n] = k; p->fcount[n] = n;
+    for (int i = 0; i < n; i++) p->fv[k++] = n + i;
+    p->fn[n + 1] = q_rotate(x.q, v3(0, 0, -1));
+    p->ffirst[n + 1] = k; p->fcount[n + 1] = n;
+    for (int i = n - 1; i >= 0; i--) p->fv[k++] = i;
+    poly_finish(p);
+}
+
+static int poly_from_shape(poly *p, const shape *s, xform x)
+{
+    switch (s->type) {
+    case SHAPE_BOX: poly_from_box(p, s->half_extents, x); return 1;
+    case SHAPE_HULL:
+        if (s->hull->vertex_count > POLY_MAX_V || s->hull->face_count > POLY_MAX_F) return 0;
+        poly_from_hull(p, s->hull, x);
+        return 1;
+    case SHAPE_CYLINDER: poly_from_cylinder(p, s->radius, s->half_height, x); return 1;
+    default: return 0;
+    }
+}
+
+/* ---- small geometry -------------------------------------------------------- */
+
+static double poly_min_along(const poly *p, vec3 n)
+{
+    double m = v3_dot(p->v[0], n);
+    for (int i = 1; i < p->nv; i++) m = fmin(m, v3_dot(p->v[i], n));
+    return m;
+}
+
+static double poly_max_along(const poly *p, vec3 n)
+{
+    double m = v3_dot(p->v[0], n);
+    for (int i = 1; i < p->nv; i++) m = fmax(m, v3_dot(p->v[i], n));
+    return m;
+}
+
+/* Closest points of segments p1q1 and p2q2 (Ericson, Real-Time Collision Detection 5.1.9). */
+static void closest_segments(vec3 p1, vec3 q1, vec3 p2, vec3 q2, vec3 *c1, vec3 *c2)
+{
+    vec3 d1 = v3_sub(q1, p1), d2 = v3_sub(q2, p2), r = v3_sub(p1, p2);
+    double a = v3_dot(d1, d1), e = v3_dot(d2, d2), f = v3_dot(d2, r), s, t;
+    if (a <= 1e-30 && e <= 1e-30) { *c1 = p1; *c2 = p2; return; }
+    if (a <= 1e-30) { s = 0; t = fmin(fmax(f / e, 0), 1); }
+    else {
+        double c = v3_dot(d1, r);
+        if (e <= 1e-30) { t = 0; s = fmin(fmax(-c / a, 0), 1); }
+        else {
+            double b = v3_dot(d1, d2), den = a * e - b * b;
+            s = den > 1e-30 * a * e ? fmin(fmax((b * f - c * e) / den, 0), 1) : 0;
+            t = (b * s + f) / e;
+            if (t < 0) { t = 0; s = fmin(fmax(-c / a, 0), 1); }
+            else if (t > 1) { t = 1; s = fmin(fmax((b - c) / a, 0), 1); }
+        }
+    }
+    *c1 = v3_madd(p1, s, d1);
+    *c2 = v3_madd(p2, t, d2);
+}
+
+static vec3 any_unit(vec3 n, vec3 fallback)
+{
+    double l = v3_len(n);
+    return l > 1e-12 ? v3_scale(n, 1.0 / l) : fallback;
+}
+
+static void add_point(manifold *m, vec3 p, double sep, uint32_t id)
+{
+    if (m->count >= MANIFOLD_MAX_POINTS) return;
+    m->points[m->count].point = p;
+    m->points[m->count].separation = sep;
+    m->points[m->count].id = id;
+    m->count++;
+}
+
+/* ---- analytic pairs ---------------------------------------------------------- */
+
+/* Two spheres (or sphere-swept points) of radii ra, rb at ca, cb. */
+static void sphere_sphere(vec3 ca, double ra, vec3 cb, double rb, double spec, uint32_t id, manifold *m)
+{
+    vec3 d = v3_sub(cb, ca);
+    double dist = v3_len(d);
+    vec3 n = dist > 1e-12 ? v3_scale(d, 1.0 / dist) : v3(0, 0, 1);
+    double sep = dist - ra - rb;
+    m->normal = n;
+    if (sep >= spec) return;
+    vec3 pa = v3_madd(ca, ra, n), pb = v3_madd(cb, -rb, n);
+    add_point(m, v3_scale(v3_add(pa, pb), 0.5), sep, id);
+}
+
+static void plane_world(const shape *pl, xform x, vec3 *n, double *d)
+{
+    *n = q_rotate(x.q, pl->plane_normal);
+    *d = pl->plane_offset + v3_dot(*n, x.p);
+}
+
+/* Shape a against plane b (normal of the manifold: from a into the plane, i.e. -plane normal). */
+static void shape_plane(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *m)
+{
+    vec3 n;
+    double d;
+    plane_world(b, xb, &n, &d);
+    m->normal = v3_neg(n);
+    manifold_point cand[POLY_MAX_V];
+    int nc = 0;
+    switch (a->type) {
+    case SHAPE_SPHERE: {
+        double sep = v3_dot(n, xa.p) - d - a->radius;
+        if (sep < spec) add_point(m, v3_madd(xa.p, -(a->radius + 0.5 * sep), n), sep, 0);
+        return;
+    }
+    case SHAPE_CAPSULE: {
+        vec3 axis = q_rotate(xa.q, v3(0, 0, a->half_height));
+        for (int i = 0; i < 2; i++) {
+            vec3 c = i ? v3_sub(xa.p, axis) : v3_add(xa.p, axis);
+            double sep = v3_dot(n, c) - d - a->radius;
+            if (sep < spec) add_point(m, v3_madd(c, -(a->radius + 0.5 * sep), n), sep, (uint32_t)i);
+        }
+        return;
+    }
+    case SHAPE_CYLINDER: {
+        /* exact rim points: the deepest rim point and its neighbours a quarter turn away */
+        vec3 axis = q_rotate(xa.q, v3(0, 0, 1));
+        vec3 radial = v3_sub(v3_neg(n), v3_scale(axis, v3_dot(v3_neg(n), axis)));
+        vec3 u, w;
+        if (v3_len2(radial) > 1e-16) { u = v3_normalize(radial); w = v3_cross(axis, u); }
+        else v3_basis(axis, &u, &w);
+        double cap_side = v3_dot(axis, n) > 0 ? -1.0 : 1.0; /* the cap nearer the plane */
+        vec3 rims[6];
+        int ids[6];
+        int k = 0;
+        for (int cap = 0; cap < 2; cap++) {
+            double hz = (cap == 0 ? cap_side : -cap_side) * a->half_height;
+            vec3 c = v3_madd(xa.p, hz, axis);
+            rims[k] = v3_madd(c, a->radius, u); ids[k++] = (uint32_t)(cap * 4 + 0);
+            if (cap == 0) {
+                rims[k] = v3_madd(c, a->radius, w); ids[k++] = 1;
+                rims[k] = v3_madd(c, -a->radius, w); ids[k++] = 2;
+                rims[k] = v3_madd(c, -a->radius, u); ids[k++] = 3;
+            }
+        }
+        for (int i = 0; i < k; i++) {
+            double sep = v3_dot(n, rims[i]) - d;
+            if (sep < spec) {
+                cand[nc].point = v3_madd(rims[i], -0.5 * sep, n);
+                cand[nc].separation = sep;
+                cand[nc].id = (uint32_t)ids[i];
+                nc++;
+            }
+        }
+        break;
+    }
+    case SHAPE_BOX: case SHAPE_HULL: {
+        poly p;
+        if (!poly_from_shape(&p, a, xa)) return;
+        for (int i = 0; i < p.nv; i++) {
+            double sep = v3_dot(n, p.v[i]) - d;
+            if (sep < spec) {
+                cand[nc].point = v3_madd(p.v[i], -0.5 * sep, n);
+                cand[nc].separation = sep;
+                cand[nc].id = (uint32_t)i;
+                nc++;
+            }
+        }
+        break;
+    }
+    default:
+        return;
+    }
+    nc = manifold_reduce(cand, nc, n);
+    for (int i = 0; i < nc; i++) m->points[i] = cand[i];
+    m->count = nc;
+}
+
+static void sphere_box(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *m)
+{
+    vec3 c = xf_inv_point(xb, xa.p), h = b->half_extents;
+    vec3 q = v3(fmin(fmax(c.x, -h.x), h.x), fmin(fmax(c.y, -h.y), h.y), fmin(fmax(c.z, -h.z), h.z));
+    vec3 d = v3_sub(c, q);
+    double dist = v3_len(d), sep;
+    vec3 nl; /* local normal from the box towards the sphere */
+    if (dist > 1e-12) {
+        nl = v3_scale(d, 1.0 / dist);
+        sep = dist - a->radius;
+    } else {
+        /* centre inside: leave through the nearest face */
+        double dx = h.x - fabs(c.x), dy = h.y - fabs(c.y), dz = h.z - fabs(c.z);
+        if (dx <= dy && dx <= dz) { nl = v3(c.x < 0 ? -1 : 1, 0, 0); q = v3(nl.x * h.x, c.y, c.z); sep = -dx - a->radius; }
+        else if (dy <= dz) { nl = v3(0, c.y < 0 ? -1 : 1, 0); q = v3(c.x, nl.y * h.y, c.z); sep = -dy - a->radius; }
+        else { nl = v3(0, 0, c.z < 0 ? -1 : 1); q = v3(c.x, c.y, nl.z * h.z); sep = -dz - a->radius; }
+    }
+    vec3 n = q_rotate(xb.q, nl);
+    m->normal = v3_neg(n); /* from the sphere (a) to the box (b) */
+    if (sep >= spec) return;
+    vec3 pb = xf_point(xb, q);
+    add_point(m, v3_madd(pb, 0.5 * sep, n), sep, 0);
+}
+
+static void capsule_segment(const shape *s, xform x, vec3 *p0, vec3 *p1)
+{
+    vec3 axis = q_rotate(x.q, v3(0, 0, s->half_height));
+    *p0 = v3_sub(x.p, axis);
+    *p1 = v3_add(x.p, axis);
+}
+
+static void sphere_capsule(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *m)
+{
+    vec3 p0, p1, ca, cb;
+    capsule_segment(b, xb, &p0, &p1);
+    closest_segments(xa.p, xa.p, p0, p1, &ca, &cb);
+    sphere_sphere(ca, a->radius, cb, b->radius, spec, 0, m);
+}
+
+static void capsule_capsule(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *m)
+{
+    vec3 a0, a1, b0, b1, ca, cb;
+    capsule_segment(a, xa, &a0, &a1);
+    capsule_segment(b, xb, &b0, &b1);
+    vec3 da = v3_sub(a1, a0), db = v3_sub(b1, b0);
+    vec3 cr = v3_cross(da, db);
+    double par = v3_len2(cr) / (v3_len2(da) * v3_len2(db) + 1e-300);
+    if (par < 1e-6) {
+        /* parallel: two points over the overlap of the segments */
+        vec3 u = v3_normalize(da);
+        double s0 = v3_dot(v3_sub(b0, a0), u), s1 = v3_dot(v3_sub(b1, a0), u), len = v3_len(da);
+        double lo = fmax(0, fmin(s0, s1)), hi = fmin(len, fmax(s0, s1));
+        if (hi > lo + 1e-9) {
+            vec3 off = v3_sub(b0, v3_madd(a0, s0, u)); /* from a's line to b's line */
+            vec3 n = any_unit(off, v3(0, 0, 1));
+            double dist = v3_len(off), sep = dist - a->radius - b->radius;
+            m->normal = n;
+            if (sep >= spec) return;
+            for (int i = 0; i < 2; i++) {
+                vec3 pa = v3_madd(a0, i ? hi : lo, u);
+                vec3 p = v3_madd(pa, a->radius + 0.5 * sep, n);
+                add_point(m, p, sep, (uint32_t)i);
+            }
+            return;
+        }
+    }
+    closest_segments(a0, a1, b0, b1, &ca, &cb);
+    sphere_sphere(ca, a->radius, cb, b->radius, spec, 0, m);
+}
+
+/* ---- polytope against polytope ----------------------------------------------- */
+
+static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip, double spec, uint32_t tag, manifold *m)
+{
+    vec3 n = ref->fn[rf];
+    /* incident face: the most anti-parallel */
+    int inf = 0;
+    double best = 1e300;
+    for (int f = 0; f < inc->nf; f++) {
+        double dd = v3_dot(inc->fn[f], n);
+        if (dd < best) { best = dd; inf = f; }
+    }
+    clip_vertex buf1[CLIP_MAX], buf2[CLIP_MAX];
+    int nbuf = inc->fcount[inf];
+    if (nbuf > CLIP_MAX / 2) nbuf = CLIP_MAX / 2;
+    for (int i = 0; i < nbuf; i++) {
+        int vi = inc->fv[inc->ffirst[inf] + i];
+        buf1[i].p = inc->v[vi];
+        buf1[i].id = (uint32_t)(vi & 0x7f);
+    }
+    clip_vertex *in = buf1, *out = buf2;
+    int rc = ref->fcount[rf];
+    for (int e = 0; e < rc && nbuf > 0; e++) {
+        vec3 a = ref->v[ref->fv[ref->ffirst[rf] + e]], b = ref->v[ref->fv[ref->ffirst[rf] + (e + 1) % rc]];
+        vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
+        if (nbuf + 1 > CLIP_MAX) break;
+        nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a), (uint32_t)(e & 0xff), out);
+        clip_vertex *t = in; in = out; out = t;
+    }
+    manifold_point cand[CLIP_MAX];
+    int nc = 0;
+    for (int i = 0; i < nbuf; i++) {
+        double sep = v3_dot(n, in[i].p) - ref->fd[rf];
+        if (sep >= spec) continue;
+        cand[nc].point = v3_madd(in[i].p, -0.5 * sep, n);
+        cand[nc].separation = sep;
+        cand[nc].id = tag | ((uint32_t)(rf & 0xff) << 20) | ((uint32_t)(inf & 0x0f) << 16) | (in[i].id & 0xffffu);
+        nc++;
+    }
+    nc = manifold_reduce(cand, nc, n);
+    m->normal = flip ? v3_neg(n) : n;
+    for (int i = 0; i < nc; i++) m->points[i] = cand[i];
+    m->count = nc;
+}
+
+/* Support of the true shape (libccd callback): the shape and its transform. */
+typedef struct ccd_obj { const shape *s; xform x; } ccd_obj;
+
+static void ccd_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    const ccd_obj *o = obj;
+    vec3 d = q_inv_rotate(o->x.q, v3(dir->v[0], dir->v[1], dir->v[2]));
+    vec3 p = xf_point(o->x, shape_support_local(o->s, d));
+    out->v[0] = p.x; out->v[1] = p.y; out->v[2] = p.z;
+}
+
+static void ccd_center(const void *obj, ccd_vec3_t *out)
+{
+    const ccd_obj *o = obj;
+    out->v[0] = o->x.p.x; out->v[1] = o->x.p.y; out->v[2] = o->x.p.z;
+}
+
+/* libccd MPR on the true shapes: the penetration direction (a to b), or 0. */
+static int ccd_normal(const shape *a, xform xa, const shape *b, xform xb, const collide_cache *cache, vec3 *n)
+{
+    ccd_t ccd;
+    CCD_INIT(&ccd);
+    ccd.support1 = ccd_support;
+    ccd.support2 = ccd_support;
+    ccd.center1 = ccd_center;
+    ccd.center2 = ccd_center;
+    ccd.max_iterations = 100;
+    ccd.epa_tolerance = 1e-10;
+    ccd.mpr_tolerance = 1e-10;
+    ccd.dist_tolerance = 1e-10;
+    (void)cache; /* MPR seeds itself from the centres */
+    ccd_obj oa = {a, xa}, ob = {b, xb};
+    ccd_real_t depth;
+    ccd_vec3_t dir, pos;
+    if (ccdMPRPenetration(&oa, &ob, &ccd, &depth, &dir, &pos) != 0) return 0;
+    vec3 d = v3(dir.v[0], dir.v[1], dir.v[2]);
+    if (!v3_is_finite(d) || !isfinite(depth) || v3_len2(d) < 0.25) return 0;
+    *n = v3_normalize(d);
+    return 1;
+}
+
+static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, double spec, collide_cache *cache,
+                      manifold *m)
+{
+    poly pa_buf, pb_buf; /* on the stack: no shared state between worlds or threads */
+    poly *pa = &pa_buf, *pb = &pb_buf;
+    if (!poly_from_shape(pa, sa, xa) || !poly_from_shape(pb, sb, xb)) return;
+    /* face axes of a, of b */
+    double sa_best = -1e300, sb_best = -1e300;
+    int fa = -1, fb = -1;
+    for (int f = 0; f < pa->nf; f++) {
+        double s = poly_min_along(pb, pa->fn[f]) - pa->fd[f];
+        if (s > sa_best) { sa_best = s; fa = f; }
+    }
+    if (sa_best > spec) { m->normal = pa->fn[fa]; return; }
+    for (int f = 0; f < pb->nf; f++) {
+        double s = poly_min_along(pa, pb->fn[f]) - pb->fd[f];
+        if (s > sb_best) { sb_best = s; fb = f; }
+    }
+    if (sb_best > spec) { m->normal = v3_neg(pb->fn[fb]); return; }
+    /* edge pairs */
+    double se_best = -1e300;
+    int ea = -1, eb = -1;
+    vec3 en = v3_zero();
+    for (int i = 0; i < pa->ne; i++) {
+        vec3 a0 = pa->v[pa->e[i][0]], da = v3_sub(pa->v[pa->e[i][1]], a0);
+        for (int j = 0; j < pb->ne; j++) {
+            vec3 db = v3_sub(pb->v[pb->e[j][1]], pb->v[pb->e[j][0]]);
+            vec3 ax = v3_cross(da, db);
+            double l2 = v3_len2(ax);
+            if (l2 < 1e-12 * v3_len2(da) * v3_len2(db)) continue;
+            ax = v3_scale(ax, 1.0 / sqrt(l2));
+            if (v3_dot(ax, v3_sub(a0, pa->center)) < 0) ax = v3_neg(ax);
+            double s = poly_min_along(pb, ax) - poly_max_along(pa, ax);
+            if (s > se_best) { se_best = s; ea = i; eb = j; en = ax; }
+            if (s > spec) { m->normal = ax; return; }
+        }
+    }
+    double face_best = fmax(sa_best, sb_best);
+    if (ea >= 0 && se_best > face_best + FACE_TOLERANCE) {
+        vec3 ca, cb;
+        closest_segments(pa->v[pa->e[ea][0]], pa->v[pa->e[ea][1]], pb->v[pb->e[eb][0]], pb->v[pb->e[eb][1]], &ca, &cb);
+        m->normal = en;
+        add_point(m, v3_scale(v3_add(ca, cb), 0.5), se_best, 0x40000000u | ((uint32_t)ea << 12) | (uint32_t)eb);
+        cache->feature = -1;
+        return;
+    }
+    /* reference face: a's unless b's separates clearly more; keep last step's choice when close */
+    int use_b = sb_best > sa_best + KEEP_TOLERANCE;
+    if (cache->feature >= 0 && fabs(sb_best - sa_best) <= KEEP_TOLERANCE) use_b = cache->flip;
+    if (sa->type == SHAPE_CYLINDER || sb->type == SHAPE_CYLINDER) {
+        /* the prism's facets only approximate a round side: ask libccd about the
+         * true cylinder and take the face most aligned with its normal */
+        vec3 n;
+        if (sa_best < 0 && sb_best < 0 && ccd_normal(sa, xa, sb, xb, cache, &n)) {
+            double best_a = -2, best_b = -2;
+            int ia = fa, ib = fb;
+            for (int f = 0; f < pa->nf; f++) if (v3_dot(pa->fn[f], n) > best_a) { best_a = v3_dot(pa->fn[f], n); ia = f; }
+            for (int f = 0; f < pb->nf; f++) if (-v3_dot(pb->fn[f], n) > best_b) { best_b = -v3_dot(pb->fn[f], n); ib = f; }
+            fa = ia;
+            fb = ib;
+            use_b = best_b > best_a;
+        }
+    }
+    cache->feature = use_b ? fb : fa;
+    cache->flip = use_b;
+    if (use_b) poly_face_contact(pb, fb, pa, 1, spec, 0x20000000u, m);
+    else poly_face_contact(pa, fa, pb, 0, spec, 0, m);
+}
+
+/* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */
+
+static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, double spec, manifold *m)
+{
+    poly pbuf;
+    poly *p = &pbuf;
+    if (!poly_from_shape(p, sp, xp)) return;
+    vec3 c0 = xc.p, c1 = xc.p;
+    int seg = sc->type == SHAPE_CAPSULE;
+    if (seg) capsule_segment(sc, xc, &c0, &c1);
+    double r = sc->radius;
+    /* face axes */
+    double best = -1e300;
+    int bf = -1;
+    for (int f = 0; f < p->nf; f++) {
+        double s = fmin(v3_dot(p->fn[f], c0), v3_dot(p->fn[f], c1)) - p->fd[f];
+        if (s > best) { best = s; bf = f; }
+    }
+    /* nearest feature from outside: the closest point of the polytope boundary
+     * to the core, by edges (covers vertex and edge regions exactly) */
+    double ebest = 1e300;
+    vec3 ep = v3_zero(), ec = v3_zero();
+    int eidx = -1;
+    if (best > 0) {
+        for (int i = 0; i < p->ne; i++) {
+            vec3 pa, pc;
+            closest_segments(p->v[p->e[i][0]], p->v[p->e[i][1]], c0, c1, &pa, &pc);
+            double d2 = v3_len2(v3_sub(pc, pa));
+            if (d2 < ebest) { ebest = d2; ep = pa; ec = pc; eidx = i; }
+        }
+        ebest = sqrt(ebest);
+    }
+    if (best > 0 && eidx >= 0 && ebest > best + 1e-9) {
+        /* the core is outside, nearest to an edge or vertex */
+        vec3 n = any_unit(v3_sub(ec, ep), p->fn[bf]);
+        double sep = ebest - r;
+        m->normal = n;
+        if (sep < spec) add_point(m, v3_madd(ep, 0.5 * sep, n), sep, 0x10000000u | (uint32_t)eidx);
+        return;
+    }
+    vec3 n = p->fn[bf];
+    m->normal = n;
+    if (best - r >= spec) return;
+    /* clip the core (point or segment) to the reference face */
+    clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
+    int nb = seg ? 2 : 1;
+    b1[0].p = c0; b1[0].id = 0;
+    b1[1].p = c1; b1[1].id = 1;
+    clip_vertex *in = b1, *out = b2;
+    int rc = p->fcount[bf];
+    for (int e = 0; e < rc && nb > 0; e++) {
+        vec3 a = p->v[p->fv[p->ffirst[bf] + e]], b = p->v[p->fv[p->ffirst[bf] + (e + 1) % rc]];
+        vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
+        if (nb == 2) {
+            nb = clip_polygon(in, 2, side, v3_dot(side, a), (uint32_t)e, out);
+            if (nb > 2) nb = 2;
+        } else {
+            nb = v3_dot(side, in[0].p) <= v3_dot(side, a) + 1e-12 ? 1 : 0;
+            out[0] = in[0];
+        }
+        clip_vertex *t = in; in = out; out = t;
+    }
+    if (nb == 0) {
+        /* the core projects outside the face: use its deepest end */
+        nb = 1;
+        in[0].p = v3_dot(n, c0) <= v3_dot(n, c1) ? c0 : c1;
+        in[0].id = 0;
+    }
+    for (int i = 0; i < nb; i++) {
+        double sep = v3_dot(n, in[i].p) - p->fd[bf] - r;
+        if (sep < spec) add_point(m, v3_madd(in[i].p, -(r + 0.5 * sep), n), sep, ((uint32_t)bf << 16) | (in[i].id & 0xffffu));
+    }
+}
+
+/* ---- dispatch ------------------------------------------------------------- */
+
+static void collide_ordered(const shape *a, xform xa, const shape *b, xform xb, double spec, collide_cache *cache,
+                            manifold *m)
+{
+    /* a->type <= b->type */
+    int ta = a->type, tb = b->type;
+    if (tb == SHAPE_PLANE) {
+        if (ta != SHAPE_PLANE) shape_plane(a, xa, b, xb, spec, m);
+        return;
+    }
+    if (ta == SHAPE_SPHERE) {
+        if (tb == SHAPE_SPHERE) sphere_sphere(xa.p, a->radius, xb.p, b->radius, spec, 0, m);
+        else if (tb == SHAPE_BOX) sphere_box(a, xa, b, xb, spec, m);
+        else if (tb == SHAPE_CAPSULE) sphere_capsule(a, xa, b, xb, spec, m);
+        else {
+            poly_core(b, xb, a, xa, spec, m);
+            m->normal = v3_neg(m->normal);
+        }
+        return;
+    }
+    if (ta == SHAPE_CAPSULE) {
+        if (tb == SHAPE_CAPSULE) capsule_capsule(a, xa, b, xb, spec, m);
+        else {
+            poly_core(b, xb, a, xa, spec, m);
+            m->normal = v3_neg(m->normal);
+        }
+        return;
+    }
+    if (ta == SHAPE_BOX && tb == SHAPE_CAPSULE) {
+        poly_core(a, xa, b, xb, spec, m);
+        return;
+    }
+    poly_poly(a, xa, b, xb, spec, cache, m);
+}
+
+int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache, manifold *m)
+{
+    memset(m, 0, sizeof *m);
+    m->normal = v3(0, 0, 1);
+    int swap = a->type > b->type;
+    /* capsule (2) against box (1) is handled box-first; everything else by type order */
+    if (swap) {
+        collide_cache flipped = *cache;
+        flipped.flip = !cache->flip;
+        flipped.normal = v3_neg(cache->normal);
+        collide_ordered(b, xb, a, xa, speculative, &flipped, m);
+        m->normal = v3_neg(m->normal);
+        cache->feature = flipped.feature;
+        cache->flip = !flipped.flip;
+    } else {
+        collide_ordered(a, xa, b, xb, speculative, cache, m);
+    }
+    /* always finite: a degenerate result becomes no contact */
+    if (!v3_is_finite(m->normal) || v3_len2(m->normal) < 0.5) {
+        m->normal = cache->has_normal ? cache->normal : v3(0, 0, 1);
+        m->count = 0;
+    }
+    for (int i = 0; i < m->count; i++)
+        if (!v3_is_finite(m->points[i].point) || !isfinite(m->points[i].separation)) { m->count = 0; break; }
+    if (m->count > 0) {
+        cache->normal = m->normal;
+        cache->has_normal = 1;
+    }
+    return m->count;
+}
