@@ -13,6 +13,8 @@
 #define CYL_SIDES 16
 #define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
 #define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */
+#define CLIP_TOLERANCE 5e-4   /* incident vertices this close outside a side plane are kept, so
+                                 aligned stacks keep the same feature ids under tiny jitter */
 
 /* A convex polytope in world space. */
 typedef struct poly {
@@ -363,7 +365,7 @@ static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip
         vec3 a = ref->v[ref->fv[ref->ffirst[rf] + e]], b = ref->v[ref->fv[ref->ffirst[rf] + (e + 1) % rc]];
         vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
         if (nbuf + 1 > CLIP_MAX) break;
-        nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a), (uint32_t)(e & 0xff), out);
+        nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a) + CLIP_TOLERANCE, (uint32_t)(e & 0xff), out);
         clip_vertex *t = in; in = out; out = t;
     }
     manifold_point cand[CLIP_MAX];
@@ -492,6 +494,66 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
     else poly_face_contact(pa, fa, pb, 0, spec, 0, m);
 }
 
+/* Box-box: the 15-axis separating-axis test in A's frame (closed forms, no
+ * vertex loops); face contacts are clipped, the rare edge-edge winner goes to
+ * the general polytope path. */
+static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double spec, collide_cache *cache,
+                    manifold *m)
+{
+    mat3 ra = m3_from_quat(xa.q), rb = m3_from_quat(xb.q);
+    vec3 ax[3] = {ra.c0, ra.c1, ra.c2}, bx[3] = {rb.c0, rb.c1, rb.c2};
+    double R[3][3], AR[3][3], t[3] = {0, 0, 0}, ha[3] = {0, 0, 0}, hb[3] = {0, 0, 0};
+    vec3 d = v3_sub(xb.p, xa.p);
+    for (int i = 0; i < 3; i++) {
+        t[i] = v3_dot(d, ax[i]);
+        ha[i] = v3_get(sa->half_extents, i);
+        hb[i] = v3_get(sb->half_extents, i);
+        for (int j = 0; j < 3; j++) {
+            R[i][j] = v3_dot(ax[i], bx[j]);
+            AR[i][j] = fabs(R[i][j]);
+        }
+    }
+    double sa_best = -1e300, sb_best = -1e300;
+    int fa = 0, fb = 0;
+    for (int i = 0; i < 3; i++) {
+        double s = fabs(t[i]) - (ha[i] + hb[0] * AR[i][0] + hb[1] * AR[i][1] + hb[2] * AR[i][2]);
+        if (s > sa_best) { sa_best = s; fa = 2 * i + (t[i] < 0); }
+    }
+    if (sa_best > spec) { m->normal = v3_scale(ax[fa / 2], fa & 1 ? -1.0 : 1.0); return; }
+    for (int j = 0; j < 3; j++) {
+        double tb = t[0] * R[0][j] + t[1] * R[1][j] + t[2] * R[2][j];
+        double s = fabs(tb) - (hb[j] + ha[0] * AR[0][j] + ha[1] * AR[1][j] + ha[2] * AR[2][j]);
+        /* b's face whose outward normal points towards a */
+        if (s > sb_best) { sb_best = s; fb = 2 * j + (tb > 0); }
+    }
+    if (sb_best > spec) { m->normal = v3_scale(bx[fb / 2], fb & 1 ? 1.0 : -1.0); return; }
+    double se_best = -1e300;
+    for (int i = 0; i < 3; i++) {
+        int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+        for (int j = 0; j < 3; j++) {
+            int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+            double len = sqrt(fmax(0.0, 1.0 - R[i][j] * R[i][j]));
+            if (len < 1e-6) continue;
+            double rad = ha[i1] * AR[i2][j] + ha[i2] * AR[i1][j] + hb[j1] * AR[i][j2] + hb[j2] * AR[i][j1];
+            double dist = fabs(t[i2] * R[i1][j] - t[i1] * R[i2][j]);
+            double s = (dist - rad) / len;
+            if (s > se_best) se_best = s;
+        }
+    }
+    if (se_best > spec) { poly_poly(sa, xa, sb, xb, spec, cache, m); return; }
+    double face_best = fmax(sa_best, sb_best);
+    if (se_best > face_best + FACE_TOLERANCE) { poly_poly(sa, xa, sb, xb, spec, cache, m); return; }
+    int use_b = sb_best > sa_best + KEEP_TOLERANCE;
+    if (cache->feature >= 0 && fabs(sb_best - sa_best) <= KEEP_TOLERANCE) use_b = cache->flip;
+    poly pa, pb;
+    poly_from_box(&pa, sa->half_extents, xa);
+    poly_from_box(&pb, sb->half_extents, xb);
+    cache->feature = use_b ? fb : fa;
+    cache->flip = use_b;
+    if (use_b) poly_face_contact(&pb, fb, &pa, 1, spec, 0x20000000u, m);
+    else poly_face_contact(&pa, fa, &pb, 0, spec, 0, m);
+}
+
 /* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */
 
 static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, double spec, manifold *m)
@@ -599,7 +661,8 @@ static void collide_ordered(const shape *a, xform xa, const shape *b, xform xb, 
         poly_core(a, xa, b, xb, spec, m);
         return;
     }
-    poly_poly(a, xa, b, xb, spec, cache, m);
+    if (ta == SHAPE_BOX && tb == SHAPE_BOX) box_box(a, xa, b, xb, spec, cache, m);
+    else poly_poly(a, xa, b, xb, spec, cache, m);
 }
 
 int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache, manifold *m)

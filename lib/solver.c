@@ -63,7 +63,8 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
             bias = s * sc->inv_h; /* speculative: arrive exactly at contact */
         } else if (use_bias) {
             if (sc->correction == CAROM_CORRECTION_SOFT) {
-                bias = fmax(c->soft.bias_rate * s, -sc->push_max);
+                bias = c->soft.bias_rate * s;
+                if (bias < -sc->push_max) bias = -sc->push_max;
                 mass_scale = c->soft.mass_scale;
                 impulse_scale = c->soft.impulse_scale;
             } else if (sc->correction == CAROM_CORRECTION_BAUMGARTE) {
@@ -72,7 +73,8 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
         }
         double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, p->rb_n) - v3_dot(wA, p->ra_n);
         double lambda = -p->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
-        double total = fmax(p->normal_impulse + lambda, 0.0);
+        double total = p->normal_impulse + lambda;
+        if (total < 0.0) total = 0.0;
         lambda = total - p->normal_impulse;
         p->normal_impulse = total;
         p->total_normal_impulse += lambda;
@@ -83,12 +85,14 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
         wB = v3_madd(wB, lambda, p->ib_n);
     }
     if (sc->friction && c->friction > 0) {
+        vec3 dv = v3_sub(vB, vA);
         for (int i = 0; i < c->count; i++) {
             constraint_point *p = &c->p[i];
-            vec3 vp = v3_sub(v3_add(vB, v3_cross(wB, p->rb)), v3_add(vA, v3_cross(wA, p->ra)));
             double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-            double n1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1);
-            double n2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
+            double v1 = v3_dot(dv, c->t1) + v3_dot(wB, p->rb_t[0]) - v3_dot(wA, p->ra_t[0]);
+            double v2 = v3_dot(dv, c->t2) + v3_dot(wB, p->rb_t[1]) - v3_dot(wA, p->ra_t[1]);
+            double n1 = o1 - p->tangent_mass[0] * v1;
+            double n2 = o2 - p->tangent_mass[1] * v2;
             /* Coulomb cone: |friction| <= mu * normal impulse */
             double limit = c->friction * p->normal_impulse;
             double mag2 = n1 * n1 + n2 * n2;
@@ -99,11 +103,13 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
             }
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
-            vec3 P = v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2));
+            double d1 = n1 - o1, d2 = n2 - o2;
+            vec3 P = v3_add(v3_scale(c->t1, d1), v3_scale(c->t2, d2));
             vA = v3_madd(vA, -mA, P);
-            wA = v3_sub(wA, m3_mulv(A->inv_inertia, v3_cross(p->ra, P)));
             vB = v3_madd(vB, mB, P);
-            wB = v3_add(wB, m3_mulv(B->inv_inertia, v3_cross(p->rb, P)));
+            wA = v3_sub(wA, v3_add(v3_scale(p->ia_t[0], d1), v3_scale(p->ia_t[1], d2)));
+            wB = v3_add(wB, v3_add(v3_scale(p->ib_t[0], d1), v3_scale(p->ib_t[1], d2)));
+            dv = v3_sub(vB, vA);
         }
     }
     A->v = vA; A->w = wA;
@@ -125,20 +131,18 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         constraint_point *p = &c->p[i];
         double s = p->base_separation + v3_dot(n, dpab) + v3_dot(sc->dq[c->b], p->rb_n) - v3_dot(sc->dq[c->a], p->ra_n);
         double k = fa * (A->inv_mass + v3_dot(p->ra_n, p->ia_n)) + fb * (B->inv_mass + v3_dot(p->rb_n, p->ib_n));
+        p->shock_normal = 0.0;
         if (k <= 0) continue;
-        double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+        /* rigid against an immovable lower body, with the soft push-out rate */
+        double bias = 0.0;
         if (s > 0.0) bias = s * sc->inv_h;
-        else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) {
-            bias = fmax(c->soft.bias_rate * s, -sc->push_max);
-            mass_scale = c->soft.mass_scale;
-            impulse_scale = c->soft.impulse_scale;
-        } else if (use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE)
+        else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) bias = fmax(c->soft.bias_rate * s, -sc->push_max);
+        else if (use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE)
             bias = fmax(sc->baumgarte * sc->inv_h * fmin(s + sc->slop, 0.0), -sc->push_max);
         double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, p->rb_n) - v3_dot(A->w, p->ra_n);
-        double lambda = -(mass_scale / k) * (vn + bias) - impulse_scale * p->normal_impulse;
-        double total = fmax(p->normal_impulse + lambda, 0.0);
-        lambda = total - p->normal_impulse;
-        p->normal_impulse = total;
+        /* the pass may pull back at most what the regular solve pushed */
+        double lambda = fmax(-(vn + bias) / k, -p->normal_impulse);
+        p->shock_normal = lambda;
         p->total_normal_impulse += lambda;
         A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
         A->w = v3_madd(A->w, -fa * lambda, p->ia_n);
@@ -150,22 +154,23 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         constraint_point *p = &c->p[i];
         vec3 vp = v3_sub(v3_add(B->v, v3_cross(B->w, p->rb)), v3_add(A->v, v3_cross(A->w, p->ra)));
         vec3 t[2] = {c->t1, c->t2};
-        double o[2] = {p->tangent_impulse[0], p->tangent_impulse[1]}, nw[2];
+        double nw[2];
         for (int j = 0; j < 2; j++) {
             vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
             double k = fa * (A->inv_mass + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
                        fb * (B->inv_mass + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
-            nw[j] = k > 0 ? o[j] - v3_dot(vp, t[j]) / k : o[j];
+            nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
         }
-        double limit = c->friction * p->normal_impulse, mag2 = nw[0] * nw[0] + nw[1] * nw[1];
+        /* Coulomb on the total: what the regular pass used plus this pass */
+        double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        double t1 = o1 + nw[0], t2 = o2 + nw[1];
+        double limit = c->friction * fmax(p->normal_impulse + p->shock_normal, 0.0), mag2 = t1 * t1 + t2 * t2;
         if (mag2 > limit * limit) {
-            double sc2 = limit / sqrt(mag2);
-            nw[0] *= sc2;
-            nw[1] *= sc2;
+            double f = limit / sqrt(mag2);
+            t1 *= f;
+            t2 *= f;
         }
-        p->tangent_impulse[0] = nw[0];
-        p->tangent_impulse[1] = nw[1];
-        vec3 P = v3_add(v3_scale(t[0], nw[0] - o[0]), v3_scale(t[1], nw[1] - o[1]));
+        vec3 P = v3_add(v3_scale(t[0], t1 - o1), v3_scale(t[1], t2 - o2));
         A->v = v3_madd(A->v, -fa * A->inv_mass, P);
         A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
         B->v = v3_madd(B->v, fb * B->inv_mass, P);
@@ -225,17 +230,16 @@ static void project_planar(carom_world *w, int nb)
     }
 }
 
+#define SHOCK_MASS_RATIO 4.0
+
 /* Levels above the ground (static/kinematic = 0) by repeated relaxation over
  * the contact graph; bodies not resting on anything stay at INT_MAX / 2. */
-static void compute_levels(contact_constraint *cc, int n, int *level, int nb, int *order, int *count_buf)
+static int compute_levels(contact_constraint *cc, int n, const impulse_body *bodies, int *level, int nb, int *order,
+                          int *count_buf)
 {
     const int far = 1 << 29;
     level[0] = 0;
     for (int k = 1; k < nb; k++) level[k] = far;
-    for (int k = 0; k < n; k++) {
-        /* kinematic bodies (inv mass 0) are ground too */
-        (void)k;
-    }
     int changed = 1;
     for (int pass = 0; changed && pass < nb + 1; pass++) {
         changed = 0;
@@ -245,18 +249,29 @@ static void compute_levels(contact_constraint *cc, int n, int *level, int nb, in
             if (level[b] + 1 < level[a]) { level[a] = level[b] + 1; changed = 1; }
         }
     }
-    /* counting sort of constraints by their lower level (capped) */
+    /* only contacts where the upper body outweighs the lower one take part
+     * (and contacts with the ground, which carry the load down): equal masses
+     * are solved well by the soft solver, and a rigid pass would fight it */
     int max_level = 0;
     for (int k = 0; k < n; k++) {
-        int l = level[cc[k].a] < level[cc[k].b] ? level[cc[k].a] : level[cc[k].b];
+        contact_constraint *c = &cc[k];
+        int la = level[c->a], lb = level[c->b];
+        double inv_lower = la < lb ? bodies[c->a].inv_mass : bodies[c->b].inv_mass;
+        double inv_upper = la < lb ? bodies[c->b].inv_mass : bodies[c->a].inv_mass;
+        int eligible = la != lb && inv_upper > 0.0 && (inv_lower == 0.0 || inv_lower >= SHOCK_MASS_RATIO * inv_upper);
+        int l = la < lb ? la : lb;
         if (l > nb) l = nb;
-        cc[k].level = l;
+        c->level = eligible ? l : -1;
         if (l > max_level) max_level = l;
     }
+    int count = 0;
     for (int l = 0; l <= max_level + 1; l++) count_buf[l] = 0;
-    for (int k = 0; k < n; k++) count_buf[cc[k].level + 1]++;
+    for (int k = 0; k < n; k++)
+        if (cc[k].level >= 0) count_buf[cc[k].level + 1]++;
     for (int l = 1; l <= max_level + 1; l++) count_buf[l] += count_buf[l - 1];
-    for (int k = 0; k < n; k++) order[count_buf[cc[k].level]++] = k;
+    for (int k = 0; k < n; k++)
+        if (cc[k].level >= 0) { order[count_buf[cc[k].level]++] = k; count++; }
+    return count;
 }
 
 int world_solve(carom_world *w, double dt)
@@ -356,6 +371,14 @@ int world_solve(carom_world *w, double dt)
             p->rb_n = v3_cross(p->rb, c->n);
             p->ia_n = m3_mulv(A->inv_inertia, p->ra_n);
             p->ib_n = m3_mulv(B->inv_inertia, p->rb_n);
+            p->ra_t[0] = v3_cross(p->ra, c->t1);
+            p->rb_t[0] = v3_cross(p->rb, c->t1);
+            p->ra_t[1] = v3_cross(p->ra, c->t2);
+            p->rb_t[1] = v3_cross(p->rb, c->t2);
+            for (int q = 0; q < 2; q++) {
+                p->ia_t[q] = m3_mulv(A->inv_inertia, p->ra_t[q]);
+                p->ib_t[q] = m3_mulv(B->inv_inertia, p->rb_t[q]);
+            }
             double kn = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->n);
             double k1 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t1);
             double k2 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t2);
@@ -380,8 +403,15 @@ int world_solve(carom_world *w, double dt)
             points++;
         }
     }
-    int shock = def->shock_propagation && !penalty;
-    if (shock) compute_levels(cc, ncon, level, nb, order, count_buf);
+    int shock = 0;
+    if (def->shock_propagation && !penalty) {
+        /* cheap test first: scenes without a heavy-on-light contact pay nothing */
+        for (int c = 0; c < ncon && !shock; c++) {
+            double ia = bodies[cc[c].a].inv_mass, ib = bodies[cc[c].b].inv_mass;
+            shock = (ia > 0 && ib >= SHOCK_MASS_RATIO * ia) || (ib > 0 && ia >= SHOCK_MASS_RATIO * ib);
+        }
+        if (shock) shock = compute_levels(cc, ncon, bodies, level, nb, order, count_buf);
+    }
 
     solve_context sc = {bodies, s->delta_position, s->delta_rotation, 1.0 / h,
                         def->contact_push_max_velocity, def->linear_slop, def->baumgarte,
@@ -406,11 +436,10 @@ int world_solve(carom_world *w, double dt)
             if (def->warm_starting) warm_start(cc, ncon, bodies);
             for (int it = 0; it < def->iterations; it++)
                 for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 1);
-            if (shock)
-                for (int o = 0; o < ncon; o++) {
-                    contact_constraint *c = &cc[order[o]];
-                    if (level[c->a] != level[c->b]) solve_constraint_shock(c, &sc, 1, level[c->a] < level[c->b]);
-                }
+            for (int o = 0; o < shock; o++) {
+                contact_constraint *c = &cc[order[o]];
+                solve_constraint_shock(c, &sc, 1, level[c->a] < level[c->b]);
+            }
         }
         project_planar(w, nb);
         /* integrate positions */
@@ -428,10 +457,10 @@ int world_solve(carom_world *w, double dt)
         if (!penalty) {
             for (int it = 0; it < def->relax_iterations; it++)
                 for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 0);
-            if (shock && def->relax_iterations > 0)
-                for (int o = 0; o < ncon; o++) {
+            if (def->relax_iterations > 0)
+                for (int o = 0; o < shock; o++) {
                     contact_constraint *c = &cc[order[o]];
-                    if (level[c->a] != level[c->b]) solve_constraint_shock(c, &sc, 0, level[c->a] < level[c->b]);
+                    solve_constraint_shock(c, &sc, 0, level[c->a] < level[c->b]);
                 }
             project_planar(w, nb);
         }
