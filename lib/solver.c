@@ -231,6 +231,7 @@ static void project_planar(carom_world *w, int nb)
 }
 
 #define SHOCK_MASS_RATIO 4.0
+#define RESTITUTION_PASSES 4
 
 /* Levels above the ground (static/kinematic = 0) by repeated relaxation over
  * the contact graph; bodies not resting on anything stay at INT_MAX / 2. */
@@ -361,6 +362,10 @@ int world_solve(carom_world *w, double dt)
         c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? static_soft : soft;
         impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
         vec3 ca = bs->center[sa], cb = bs->center[sb];
+        /* relative normal acceleration from gravity (b relative to a) */
+        double ga = bodies[c->a].inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
+        double gb = bodies[c->b].inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
+        double an = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
         contacts_touching++;
         for (int j = 0; j < c->count; j++) {
             const manifold_point *mp = &ct->m.points[j];
@@ -387,6 +392,11 @@ int world_solve(carom_world *w, double dt)
             p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
             p->base_separation = mp->separation;
             p->relative_velocity = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
+            if (p->relative_velocity < 0.0 && mp->separation > 0.0 && an < 0.0) {
+                /* the gap closes under gravity before impact: restitution needs the
+                 * approach speed at impact, v^2 = v0^2 + 2 |a| gap */
+                p->relative_velocity = -sqrt(p->relative_velocity * p->relative_velocity - 2.0 * an * mp->separation);
+            }
             p->normal_impulse = ws * ct->state[j].normal_impulse;
             p->tangent_impulse[0] = ws * ct->state[j].tangent_impulse[0];
             p->tangent_impulse[1] = ws * ct->state[j].tangent_impulse[1];
@@ -466,7 +476,9 @@ int world_solve(carom_world *w, double dt)
         }
     }
     if (!penalty && def->enable_restitution) {
-        apply_restitution(cc, ncon, bodies, def->restitution_threshold);
+        /* a few passes: simultaneous impacts (a ball meeting a wall and a ball at once)
+         * need the impulses to agree, which one Gauss-Seidel sweep does not give */
+        for (int it = 0; it < RESTITUTION_PASSES; it++) apply_restitution(cc, ncon, bodies, def->restitution_threshold);
         project_planar(w, nb);
     }
 
@@ -532,6 +544,17 @@ int world_solve(carom_world *w, double dt)
         if (bs->flags[slot] & BODY_HAS_FORCE) {
             bs->force[slot] = v3_zero();
             bs->flags[slot] &= ~(uint32_t)BODY_HAS_FORCE;
+        }
+        if (!(bs->flags[slot] & BODY_LOCK_ROTATION) && bodies[b].inv_mass > 0.0 &&
+            (av.x != 0.0 || av.y != 0.0 || av.z != 0.0)) {
+            /* the solver worked with the step's starting inertia; carry its angular
+             * momentum L = I_start w to the new orientation (w = I_end^-1 L), so a
+             * freely tumbling body conserves L rather than w */
+            vec3 L = m3_mulv(m3_inverse(bodies[b].inv_inertia), av);
+            body_update_inertia(bs, slot);
+            av = m3_mulv(bs->inv_inertia_world[slot], L);
+            if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));
+            bs->angular_velocity[slot] = av;
         }
         body_update_inertia(bs, slot);
         awake++;

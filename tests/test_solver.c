@@ -78,7 +78,11 @@ static void step_n(carom_world *w, int n, double dt)
 static void test_bounce_height(void **state)
 {
     (void)state;
-    carom_world *w = world_with(carom_world_def_default(), 1, 0.0, 0.0);
+    /* 8 sub-steps: semi-implicit Euler flies a ballistic arc low by about
+     * v h / 2 (h the sub-step), 2.8 % of this apex at the default 4 */
+    carom_world_def wd = carom_world_def_default();
+    wd.substeps = 8;
+    carom_world *w = world_with(wd, 1, 0.0, 0.0);
     carom_body_def d = carom_body_def_default();
     double r = 0.1;
     d.position = vec(0, 0, 1.0 + r);
@@ -124,7 +128,7 @@ static void test_sliding_stop_distance(void **state)
 }
 
 /* Box on a plane inclined by `deg`; returns displacement along the slope after t seconds. */
-static double incline_run(double deg, double t, double *lateral)
+static double incline_run(double deg, double t, double *lateral, double *accel)
 {
     double a = deg * PI_ / 180.0;
     carom_world_def wd = carom_world_def_default();
@@ -145,13 +149,14 @@ static double incline_run(double deg, double t, double *lateral)
     d.friction = 0.5;
     d.enable_sleep = 0;
     carom_body_id box = carom_body_create(w, &d);
-    step_n(w, 30, DT); /* settle: contact forms at rest */
-    carom_vec3 p0 = pos(w, box);
+    step_n(w, 30, DT); /* settle: the contact forms */
+    carom_vec3 p0 = pos(w, box), v0 = vel(w, box);
     step_n(w, (int)lround(t / DT), DT);
-    carom_vec3 p1 = pos(w, box);
+    carom_vec3 p1 = pos(w, box), v1 = vel(w, box);
     /* down-slope direction: (cos a, 0, -sin a) */
     double along = (p1.x - p0.x) * cos(a) - (p1.z - p0.z) * sin(a);
     if (lateral) *lateral = fabs(p1.y - p0.y);
+    if (accel) *accel = ((v1.x - v0.x) * cos(a) - (v1.z - v0.z) * sin(a)) / t;
     carom_world_destroy(w);
     return along;
 }
@@ -160,7 +165,7 @@ static void test_incline_static_friction(void **state)
 {
     (void)state;
     double lateral;
-    double moved = incline_run(20.0, 5.0, &lateral);
+    double moved = incline_run(20.0, 5.0, &lateral, NULL);
     if (!(fabs(moved) < 1e-3)) { print_error("moved %.6f m on a 20 degree slope\n", moved); fail(); }
 }
 
@@ -169,9 +174,8 @@ static void test_incline_sliding_acceleration(void **state)
     (void)state;
     double a = 35.0 * PI_ / 180.0, t = 2.0;
     double expected_acc = G * (sin(a) - 0.5 * cos(a)); /* 1.609 m/s^2 */
-    double d = incline_run(35.0, t, NULL);
-    /* the box starts from rest after settling: d = a t^2 / 2 */
-    double acc = 2.0 * d / (t * t);
+    double acc;
+    incline_run(35.0, t, NULL, &acc); /* a = change of the down-slope speed over t */
     EXPECT_NEAR(acc, expected_acc, 0.03 * expected_acc, "sliding acceleration");
 }
 
@@ -445,9 +449,11 @@ static void test_locks(void **state)
     carom_world_destroy(w);
 }
 
-static void test_momentum_conserved_in_free_collisions(void **state)
+/* A box and a capsule collide in free space: linear momentum is conserved
+ * exactly; angular momentum about the origin to first order in dt (contact
+ * anchors are fixed over a step), so its error must shrink with dt. */
+static double momentum_run(double dt, double *lin_err)
 {
-    (void)state;
     carom_world_def wd = carom_world_def_default();
     wd.gravity = vec(0, 0, 0);
     carom_world *w = carom_world_create(&wd);
@@ -466,13 +472,33 @@ static void test_momentum_conserved_in_free_collisions(void **state)
     carom_body_create(w, &b);
     carom_vec3 p0, l0, p1, l1;
     carom_world_get_momentum(w, &p0, &l0);
-    step_n(w, 120, DT);
+    int hits = 0;
+    for (int i = 0; i < (int)lround(2.0 / dt); i++) {
+        step_n(w, 1, dt);
+        const carom_contact_event *ev;
+        int n = carom_world_get_events(w, &ev);
+        for (int j = 0; j < n; j++) hits += ev[j].type == CAROM_EVENT_BEGIN;
+    }
+    assert_true(hits > 0); /* they did collide */
     carom_world_get_momentum(w, &p1, &l1);
-    assert_true(fabs(p1.x - p0.x) < 1e-9 && fabs(p1.y - p0.y) < 1e-9 && fabs(p1.z - p0.z) < 1e-9);
-    EXPECT_NEAR(l1.x, l0.x, 1e-6 * (1 + fabs(l0.x)), "angular momentum x");
-    EXPECT_NEAR(l1.y, l0.y, 1e-6 * (1 + fabs(l0.y)), "angular momentum y");
-    EXPECT_NEAR(l1.z, l0.z, 1e-6 * (1 + fabs(l0.z)), "angular momentum z");
+    *lin_err = sqrt(pow(p1.x - p0.x, 2) + pow(p1.y - p0.y, 2) + pow(p1.z - p0.z, 2));
+    double lerr = sqrt(pow(l1.x - l0.x, 2) + pow(l1.y - l0.y, 2) + pow(l1.z - l0.z, 2));
+    double lmag = sqrt(l0.x * l0.x + l0.y * l0.y + l0.z * l0.z);
     carom_world_destroy(w);
+    return lerr / lmag;
+}
+
+static void test_momentum_conserved_in_free_collisions(void **state)
+{
+    (void)state;
+    double lin1, lin2;
+    double coarse = momentum_run(1.0 / 300, &lin1);
+    double fine = momentum_run(1.0 / 600, &lin2);
+    assert_true(lin1 < 1e-9 && lin2 < 1e-9);
+    if (!(fine < 0.01 && fine < 0.75 * coarse)) {
+        print_error("angular momentum error %.5f at dt 1/300, %.5f at dt 1/600\n", coarse, fine);
+        fail();
+    }
 }
 
 int main(void)
