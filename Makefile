@@ -37,7 +37,11 @@ LDLIBS_ALL := $(CCD_LIBS) -lm
 LIB_SRC := $(wildcard lib/*.c)
 LIB_OBJ := $(patsubst lib/%.c,$(BUILD)/lib/%.o,$(LIB_SRC))
 STATIC  := $(BUILD)/libcarom.a
+ifeq ($(SAN),1)
+SHARED  := $(BUILD)/$(SONAME)
+else
 SHARED  := lib/$(SONAME)
+endif
 
 TEST_SRC  := $(wildcard tests/test_*.c)
 TEST_BIN  := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
@@ -50,7 +54,7 @@ LUA_SRC   := $(filter-out lua/carom-run.c,$(wildcard lua/*.c))
 
 .PHONY: all check check-c check-san check-lua test demo bench install abi-check abi-baseline deps clean
 
-all: $(SHARED) lib/libcarom.so lib/libcarom.a $(if $(wildcard lua/carom-run.c),$(RUNNER) $(LUA_MOD))
+all: $(SHARED) $(if $(filter 1,$(SAN)),,lib/libcarom.so lib/libcarom.a) $(if $(wildcard lua/carom-run.c),$(RUNNER) $(LUA_MOD))
 
 $(BUILD)/lib/%.o: lib/%.c $(wildcard lib/*.h) $(wildcard include/carom/*.h) | $(BUILD)/lib
 	$(CC) $(CFLAGS_ALL) -c $< -o $@
@@ -99,7 +103,7 @@ check: deps
 
 test: check
 
-check-c: $(TEST_BIN) $(SHARED) lib/libcarom.so
+check-c: $(TEST_BIN)
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; CAROM_ROOT=$(CURDIR) ./$$t 2>&1; done
 
 check-lua: $(if $(wildcard lua/carom-run.c),$(RUNNER))
