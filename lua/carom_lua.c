@@ -412,6 +412,13 @@ static const char *const body_keys[] = {"type", "shape", "position", "velocity",
                                         "lock_to_plane", "plane_normal", "gravity_scale", "linear_damping",
                                         "angular_damping", "sleep", "awake", "data", NULL};
 
+/* Errors of add_body name it and its table argument explicitly (as
+ * "bad argument #2 to 'add_body' (...)"), however the method was reached. */
+static int add_body_error(lua_State *L, const char *msg)
+{
+    return luaL_error(L, "bad argument #2 to 'add_body' (%s)", msg);
+}
+
 static int world_add_body(lua_State *L)
 {
     lworld *lw = check_world(L, 1);
@@ -423,12 +430,12 @@ static int world_add_body(lua_State *L)
         if (t && strcmp(t, "static") == 0) d.type = CAROM_BODY_STATIC;
         else if (t && strcmp(t, "kinematic") == 0) d.type = CAROM_BODY_KINEMATIC;
         else if (t && strcmp(t, "dynamic") == 0) d.type = CAROM_BODY_DYNAMIC;
-        else luaL_argerror(L, 2, "type must be \"static\", \"kinematic\" or \"dynamic\"");
+        else add_body_error(L, "type must be \"static\", \"kinematic\" or \"dynamic\"");
     }
     lua_pop(L, 1);
-    if (lua_getfield(L, 2, "shape") == LUA_TNIL) luaL_argerror(L, 2, "shape is required (e.g. carom.sphere{radius = 0.5})");
+    if (lua_getfield(L, 2, "shape") == LUA_TNIL) add_body_error(L, "shape is required (e.g. carom.sphere{radius = 0.5})");
     lshape *s = luaL_testudata(L, -1, SHAPE_MT);
-    if (!s) luaL_argerror(L, 2, "shape must be made by carom.sphere/box/capsule/cylinder/hull/plane");
+    if (!s) add_body_error(L, "shape must be made by carom.sphere/box/capsule/cylinder/hull/plane");
     d.shape = s->def;
     opt_vec3_field(L, 2, "position", &d.position);
     opt_vec3_field(L, 2, "velocity", &d.linear_velocity);
@@ -436,10 +443,10 @@ static int world_add_body(lua_State *L)
     opt_vec3_field(L, 2, "plane_normal", &d.plane_normal);
     if (lua_getfield(L, 2, "orientation") != LUA_TNIL) {
         double q[4];
-        if (!lua_istable(L, -1)) luaL_argerror(L, 2, "orientation must be a quaternion {w, x, y, z}");
+        if (!lua_istable(L, -1)) add_body_error(L, "orientation must be a quaternion {w, x, y, z}");
         for (int i = 0; i < 4; i++) {
             lua_geti(L, -1, i + 1);
-            if (!lua_isnumber(L, -1)) luaL_argerror(L, 2, "orientation must be a quaternion {w, x, y, z}");
+            if (!lua_isnumber(L, -1)) add_body_error(L, "orientation must be a quaternion {w, x, y, z}");
             q[i] = lua_tonumber(L, -1);
             lua_pop(L, 1);
         }
@@ -463,7 +470,7 @@ static int world_add_body(lua_State *L)
         const char *msg = carom_world_last_error(lw->w);
         if (strncmp(msg, "body_create: ", 13) == 0) msg += 13;
         if (strstr(msg, "locked") || strstr(msg, "callback")) luaL_error(L, "add_body: %s", msg);
-        luaL_argerror(L, 2, msg);
+        add_body_error(L, msg);
     }
     push_body(L, 1, id);
     if (lua_getfield(L, 2, "data") != LUA_TNIL) lua_setiuservalue(L, -2, 2);
