@@ -194,7 +194,7 @@ static void warm_start(contact_constraint *cc, int n, impulse_body *bodies)
     }
 }
 
-static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodies, double threshold)
+static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodies, double threshold, int friction)
 {
     for (int k = 0; k < n; k++) {
         contact_constraint *c = &cc[k];
@@ -211,6 +211,21 @@ static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodie
             p->total_normal_impulse += lambda;
             if (total > p->max_normal_impulse) p->max_normal_impulse = total;
             impulse_apply(B, A, p->rb, p->ra, v3_scale(c->n, lambda));
+            if (!friction || c->friction <= 0.0) continue;
+            /* the rebound impulse raises the Coulomb bound too (the seed's mu J
+             * with J including restitution): friction may now stop more slip */
+            vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
+            double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+            double n1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1), n2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
+            double limit = c->friction * p->normal_impulse, mag2 = n1 * n1 + n2 * n2;
+            if (mag2 > limit * limit) {
+                double f = limit / sqrt(mag2);
+                n1 *= f;
+                n2 *= f;
+            }
+            p->tangent_impulse[0] = n1;
+            p->tangent_impulse[1] = n2;
+            impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2)));
         }
     }
 }
@@ -478,7 +493,7 @@ int world_solve(carom_world *w, double dt)
     if (!penalty && def->enable_restitution) {
         /* a few passes: simultaneous impacts (a ball meeting a wall and a ball at once)
          * need the impulses to agree, which one Gauss-Seidel sweep does not give */
-        for (int it = 0; it < RESTITUTION_PASSES; it++) apply_restitution(cc, ncon, bodies, def->restitution_threshold);
+        for (int it = 0; it < RESTITUTION_PASSES; it++) apply_restitution(cc, ncon, bodies, def->restitution_threshold, friction_on);
         project_planar(w, nb);
     }
 
