@@ -21,7 +21,7 @@ static void add_pair(void *ctx, int ida, int idb)
     int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
     /* material mixing: friction sqrt(mu1 mu2), restitution max(e1, e2) */
     c->friction = sqrt(s->friction[a] * s->friction[b]);
-    c->restitution = fmax(s->restitution[a], s->restitution[b]);
+    c->restitution = dmax(s->restitution[a], s->restitution[b]);
 }
 
 void world_update_pairs(carom_world *w)
@@ -84,7 +84,7 @@ void world_collide(carom_world *w)
         /* a fast pair looks ahead by its closing travel this step */
         double spec = speculative;
         double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
-        if (closing > spec) spec = fmin(closing, speculative + 4.0 * AABB_MARGIN);
+        if (closing > spec) spec = dmin(closing, speculative + 4.0 * AABB_MARGIN);
         manifold old_m = c->m;
         contact_point_state old_state[MANIFOLD_MAX_POINTS];
         memcpy(old_state, c->state, sizeof old_state);

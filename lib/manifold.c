@@ -64,8 +64,8 @@ int manifold_reduce(manifold_point *pts, int n, vec3 normal)
     best = -1;
     for (int i = 0; i < n; i++) {
         if (used[i]) continue;
-        double a = fmax(area2(pts[i0].point, pts[i1].point, pts[i].point, normal),
-                        fmax(area2(pts[i1].point, pts[i2].point, pts[i].point, normal),
+        double a = dmax(area2(pts[i0].point, pts[i1].point, pts[i].point, normal),
+                        dmax(area2(pts[i1].point, pts[i2].point, pts[i].point, normal),
                              area2(pts[i2].point, pts[i0].point, pts[i].point, normal)));
         if (a > best) { best = a; i3 = i; }
     }

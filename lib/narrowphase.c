@@ -122,14 +122,14 @@ static int poly_from_shape(poly *p, const shape *s, xform x)
 static double poly_min_along(const poly *p, vec3 n)
 {
     double m = v3_dot(p->v[0], n);
-    for (int i = 1; i < p->nv; i++) m = fmin(m, v3_dot(p->v[i], n));
+    for (int i = 1; i < p->nv; i++) m = dmin(m, v3_dot(p->v[i], n));
     return m;
 }
 
 static double poly_max_along(const poly *p, vec3 n)
 {
     double m = v3_dot(p->v[0], n);
-    for (int i = 1; i < p->nv; i++) m = fmax(m, v3_dot(p->v[i], n));
+    for (int i = 1; i < p->nv; i++) m = dmax(m, v3_dot(p->v[i], n));
     return m;
 }
 
@@ -139,16 +139,16 @@ static void closest_segments(vec3 p1, vec3 q1, vec3 p2, vec3 q2, vec3 *c1, vec3 
     vec3 d1 = v3_sub(q1, p1), d2 = v3_sub(q2, p2), r = v3_sub(p1, p2);
     double a = v3_dot(d1, d1), e = v3_dot(d2, d2), f = v3_dot(d2, r), s, t;
     if (a <= 1e-30 && e <= 1e-30) { *c1 = p1; *c2 = p2; return; }
-    if (a <= 1e-30) { s = 0; t = fmin(fmax(f / e, 0), 1); }
+    if (a <= 1e-30) { s = 0; t = dmin(dmax(f / e, 0), 1); }
     else {
         double c = v3_dot(d1, r);
-        if (e <= 1e-30) { t = 0; s = fmin(fmax(-c / a, 0), 1); }
+        if (e <= 1e-30) { t = 0; s = dmin(dmax(-c / a, 0), 1); }
         else {
             double b = v3_dot(d1, d2), den = a * e - b * b;
-            s = den > 1e-30 * a * e ? fmin(fmax((b * f - c * e) / den, 0), 1) : 0;
+            s = den > 1e-30 * a * e ? dmin(dmax((b * f - c * e) / den, 0), 1) : 0;
             t = (b * s + f) / e;
-            if (t < 0) { t = 0; s = fmin(fmax(-c / a, 0), 1); }
-            else if (t > 1) { t = 1; s = fmin(fmax((b - c) / a, 0), 1); }
+            if (t < 0) { t = 0; s = dmin(dmax(-c / a, 0), 1); }
+            else if (t > 1) { t = 1; s = dmin(dmax((b - c) / a, 0), 1); }
         }
     }
     *c1 = v3_madd(p1, s, d1);
@@ -272,7 +272,7 @@ static void shape_plane(const shape *a, xform xa, const shape *b, xform xb, doub
 static void sphere_box(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *m)
 {
     vec3 c = xf_inv_point(xb, xa.p), h = b->half_extents;
-    vec3 q = v3(fmin(fmax(c.x, -h.x), h.x), fmin(fmax(c.y, -h.y), h.y), fmin(fmax(c.z, -h.z), h.z));
+    vec3 q = v3(dmin(dmax(c.x, -h.x), h.x), dmin(dmax(c.y, -h.y), h.y), dmin(dmax(c.z, -h.z), h.z));
     vec3 d = v3_sub(c, q);
     double dist = v3_len(d), sep;
     vec3 nl; /* local normal from the box towards the sphere */
@@ -320,7 +320,7 @@ static void capsule_capsule(const shape *a, xform xa, const shape *b, xform xb, 
         /* parallel: two points over the overlap of the segments */
         vec3 u = v3_normalize(da);
         double s0 = v3_dot(v3_sub(b0, a0), u), s1 = v3_dot(v3_sub(b1, a0), u), len = v3_len(da);
-        double lo = fmax(0, fmin(s0, s1)), hi = fmin(len, fmax(s0, s1));
+        double lo = dmax(0, dmin(s0, s1)), hi = dmin(len, dmax(s0, s1));
         if (hi > lo + 1e-9) {
             vec3 off = v3_sub(b0, v3_madd(a0, s0, u)); /* from a's line to b's line */
             vec3 n = any_unit(off, v3(0, 0, 1));
@@ -462,7 +462,7 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
             if (s > spec) { m->normal = ax; return; }
         }
     }
-    double face_best = fmax(sa_best, sb_best);
+    double face_best = dmax(sa_best, sb_best);
     if (ea >= 0 && se_best > face_best + FACE_TOLERANCE) {
         vec3 ca, cb;
         closest_segments(pa->v[pa->e[ea][0]], pa->v[pa->e[ea][1]], pb->v[pb->e[eb][0]], pb->v[pb->e[eb][1]], &ca, &cb);
@@ -528,21 +528,39 @@ static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double
     }
     if (sb_best > spec) { m->normal = v3_scale(bx[fb / 2], fb & 1 ? 1.0 : -1.0); return; }
     double se_best = -1e300;
+    int ei = -1, ej = -1;
     for (int i = 0; i < 3; i++) {
         int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
         for (int j = 0; j < 3; j++) {
             int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-            double len = sqrt(fmax(0.0, 1.0 - R[i][j] * R[i][j]));
+            double len = sqrt(dmax(0.0, 1.0 - R[i][j] * R[i][j]));
             if (len < 1e-6) continue;
             double rad = ha[i1] * AR[i2][j] + ha[i2] * AR[i1][j] + hb[j1] * AR[i][j2] + hb[j2] * AR[i][j1];
             double dist = fabs(t[i2] * R[i1][j] - t[i1] * R[i2][j]);
             double s = (dist - rad) / len;
-            if (s > se_best) se_best = s;
+            if (s > se_best) { se_best = s; ei = i; ej = j; }
         }
     }
-    if (se_best > spec) { poly_poly(sa, xa, sb, xb, spec, cache, m); return; }
-    double face_best = fmax(sa_best, sb_best);
-    if (se_best > face_best + FACE_TOLERANCE) { poly_poly(sa, xa, sb, xb, spec, cache, m); return; }
+    double face_best = dmax(sa_best, sb_best);
+    if (ei >= 0 && (se_best > spec || se_best > face_best + FACE_TOLERANCE)) {
+        /* edge against edge: the two edges nearest each other along the axis */
+        vec3 L = v3_normalize(v3_cross(ax[ei], bx[ej]));
+        if (v3_dot(L, d) < 0) L = v3_neg(L);
+        m->normal = L;
+        cache->feature = -1;
+        if (se_best > spec) return;
+        vec3 ca = xa.p, cb = xb.p;
+        for (int k = 0; k < 3; k++) {
+            if (k != ei) ca = v3_madd(ca, v3_dot(L, ax[k]) > 0 ? ha[k] : -ha[k], ax[k]);
+            if (k != ej) cb = v3_madd(cb, v3_dot(L, bx[k]) > 0 ? -hb[k] : hb[k], bx[k]);
+        }
+        vec3 pa, pb;
+        closest_segments(v3_madd(ca, -ha[ei], ax[ei]), v3_madd(ca, ha[ei], ax[ei]),
+                         v3_madd(cb, -hb[ej], bx[ej]), v3_madd(cb, hb[ej], bx[ej]), &pa, &pb);
+        add_point(m, v3_scale(v3_add(pa, pb), 0.5), v3_dot(L, v3_sub(pb, pa)),
+                  0x40000000u | ((uint32_t)(3 * ei + ej) << 8));
+        return;
+    }
     int use_b = sb_best > sa_best + KEEP_TOLERANCE;
     if (cache->feature >= 0 && fabs(sb_best - sa_best) <= KEEP_TOLERANCE) use_b = cache->flip;
     poly pa, pb;
@@ -569,7 +587,7 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
     double best = -1e300;
     int bf = -1;
     for (int f = 0; f < p->nf; f++) {
-        double s = fmin(v3_dot(p->fn[f], c0), v3_dot(p->fn[f], c1)) - p->fd[f];
+        double s = dmin(v3_dot(p->fn[f], c0), v3_dot(p->fn[f], c1)) - p->fd[f];
         if (s > best) { best = s; bf = f; }
     }
     /* nearest feature from outside: the closest point of the polytope boundary

@@ -68,7 +68,7 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
                 mass_scale = c->soft.mass_scale;
                 impulse_scale = c->soft.impulse_scale;
             } else if (sc->correction == CAROM_CORRECTION_BAUMGARTE) {
-                bias = fmax(sc->baumgarte * sc->inv_h * fmin(s + sc->slop, 0.0), -sc->push_max);
+                bias = dmax(sc->baumgarte * sc->inv_h * dmin(s + sc->slop, 0.0), -sc->push_max);
             }
         }
         double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, p->rb_n) - v3_dot(wA, p->ra_n);
@@ -136,12 +136,12 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         /* rigid against an immovable lower body, with the soft push-out rate */
         double bias = 0.0;
         if (s > 0.0) bias = s * sc->inv_h;
-        else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) bias = fmax(c->soft.bias_rate * s, -sc->push_max);
+        else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) bias = dmax(c->soft.bias_rate * s, -sc->push_max);
         else if (use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE)
-            bias = fmax(sc->baumgarte * sc->inv_h * fmin(s + sc->slop, 0.0), -sc->push_max);
+            bias = dmax(sc->baumgarte * sc->inv_h * dmin(s + sc->slop, 0.0), -sc->push_max);
         double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, p->rb_n) - v3_dot(A->w, p->ra_n);
         /* the pass may pull back at most what the regular solve pushed */
-        double lambda = fmax(-(vn + bias) / k, -p->normal_impulse);
+        double lambda = dmax(-(vn + bias) / k, -p->normal_impulse);
         p->shock_normal = lambda;
         p->total_normal_impulse += lambda;
         A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
@@ -164,7 +164,7 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         /* Coulomb on the total: what the regular pass used plus this pass */
         double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
         double t1 = o1 + nw[0], t2 = o2 + nw[1];
-        double limit = c->friction * fmax(p->normal_impulse + p->shock_normal, 0.0), mag2 = t1 * t1 + t2 * t2;
+        double limit = c->friction * dmax(p->normal_impulse + p->shock_normal, 0.0), mag2 = t1 * t1 + t2 * t2;
         if (mag2 > limit * limit) {
             double f = limit / sqrt(mag2);
             t1 *= f;
@@ -205,7 +205,7 @@ static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodie
             if (p->relative_velocity > -threshold || p->max_normal_impulse == 0.0) continue;
             double vn = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
             double lambda = -p->normal_mass * (vn + c->restitution * p->relative_velocity);
-            double total = fmax(p->normal_impulse + lambda, 0.0);
+            double total = dmax(p->normal_impulse + lambda, 0.0);
             lambda = total - p->normal_impulse;
             p->normal_impulse = total;
             p->total_normal_impulse += lambda;
@@ -345,7 +345,7 @@ int world_solve(carom_world *w, double dt)
     int *level = order + ncon;
     int *count_buf = level + nb + 1;
 
-    double contact_hertz = fmin(def->contact_hertz, 0.25 / h);
+    double contact_hertz = dmin(def->contact_hertz, 0.25 / h);
     softness soft = make_softness(contact_hertz, def->contact_damping_ratio, h);
     softness static_soft = make_softness(2.0 * contact_hertz, def->contact_damping_ratio, h);
     double ws = def->warm_starting ? 1.0 : 0.0;

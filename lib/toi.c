@@ -15,12 +15,12 @@ static double min_extent(const shape *s)
 {
     switch (s->type) {
     case SHAPE_SPHERE: case SHAPE_CAPSULE: return s->radius;
-    case SHAPE_BOX: return fmin(s->half_extents.x, fmin(s->half_extents.y, s->half_extents.z));
-    case SHAPE_CYLINDER: return fmin(s->radius, s->half_height);
+    case SHAPE_BOX: return dmin(s->half_extents.x, dmin(s->half_extents.y, s->half_extents.z));
+    case SHAPE_CYLINDER: return dmin(s->radius, s->half_height);
     case SHAPE_HULL: {
         double m = 1e300;
         for (int i = 0; i < s->hull->face_count; i++)
-            m = fmin(m, s->hull->faces[i].offset - v3_dot(s->hull->faces[i].normal, s->hull->centroid));
+            m = dmin(m, s->hull->faces[i].offset - v3_dot(s->hull->faces[i].normal, s->hull->centroid));
         return m > 0 ? m : 0.0;
     }
     default: return 1e300;
@@ -50,7 +50,7 @@ static double separation_at(const carom_world *w, int slot, vec3 c, int other, d
     collide(&s->shapes[slot], xa, &s->shapes[other], xb, range, &cache, &m);
     if (m.count == 0) return range;
     double d = m.points[0].separation;
-    for (int i = 1; i < m.count; i++) d = fmin(d, m.points[i].separation);
+    for (int i = 1; i < m.count; i++) d = dmin(d, m.points[i].separation);
     return d;
 }
 
@@ -95,7 +95,7 @@ void world_continuous(carom_world *w, double dt)
         if (!bullet && travel <= min_extent(&s->shapes[i])) continue;
         if (travel <= 0) continue;
         sweep_query q = {w, i, v3_sub(s->center[i], delta), s->center[i], bullet, 1.0,
-                         fmax(0.5 * w->def.linear_slop, 1e-4)};
+                         dmax(0.5 * w->def.linear_slop, 1e-4)};
         aabb a0 = shape_aabb(&s->shapes[i], (xform){v3_sub(body_origin(s, i), delta), s->rotation[i]});
         aabb a1 = shape_aabb(&s->shapes[i], body_xform(s, i));
         bp_query(w->bp, aabb_fatten(aabb_union(a0, a1), q.target), sweep_against, &q);

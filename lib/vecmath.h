@@ -5,6 +5,10 @@
 
 #include <math.h>
 
+/* min/max that compile to one instruction (libm's fmin/fmax are calls) */
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
 typedef struct vec3 { double x, y, z; } vec3;
 typedef struct quat { double w, x, y, z; } quat;          /* unit, w first */
 typedef struct mat3 { vec3 c0, c1, c2; } mat3;             /* column major */
@@ -27,8 +31,8 @@ static inline vec3 v3_cross(vec3 a, vec3 b)
 static inline double v3_len2(vec3 a) { return v3_dot(a, a); }
 static inline double v3_len(vec3 a) { return sqrt(v3_dot(a, a)); }
 static inline vec3 v3_abs(vec3 a) { return v3(fabs(a.x), fabs(a.y), fabs(a.z)); }
-static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
-static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(dmin(a.x, b.x), dmin(a.y, b.y), dmin(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(dmax(a.x, b.x), dmax(a.y, b.y), dmax(a.z, b.z)); }
 static inline vec3 v3_lerp(vec3 a, vec3 b, double t) { return v3_madd(a, t, v3_sub(b, a)); }
 static inline double v3_get(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
 static inline int v3_is_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
