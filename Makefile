@@ -113,7 +113,7 @@ check-lua: $(if $(wildcard lua/carom-run.c),$(RUNNER))
 demo: deps all
 	./$(RUNNER) demos/showcase.lua
 
-bench: all $(BENCH_BIN)
+bench: deps all $(BENCH_BIN)
 	./bench/run.sh
 
 # ---- install --------------------------------------------------------------

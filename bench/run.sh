@@ -24,3 +24,13 @@ cp peers/build/raw.txt out/peers_raw.txt
 echo
 echo "== broadphase pair finding"
 ../build/bench/bench_broadphase | tee out/broadphase.txt
+echo
+echo "== speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
+../build/bench/sweep --runs 3 > out/sweep.csv
+lua5.4 plot.lua out/sweep.csv out | tee out/pareto.txt
+echo
+echo "== scaling: pile of 100 to 50,000 bodies"
+../build/bench/scaling | tee out/scaling.csv
+lua5.4 plot_scaling.lua out/scaling.csv out/scaling.svg
+echo
+echo "bench: results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto_*.svg, scaling.svg)"
