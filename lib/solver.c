@@ -335,13 +335,20 @@ int world_solve(carom_world *w, double dt)
     }
 
     /* constraints from touching manifolds */
-    int ncon = 0;
+    int ncon = 0, npoints = 0;
     for (int i = 0; i < cs->count; i++)
-        if ((cs->items[i].flags & (CONTACT_SIM | CONTACT_TOUCHING)) == (CONTACT_SIM | CONTACT_TOUCHING)) ncon++;
-    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(int) * (size_t)(3 * ncon + 2 * nb + 4);
+        if ((cs->items[i].flags & (CONTACT_SIM | CONTACT_TOUCHING)) == (CONTACT_SIM | CONTACT_TOUCHING)) {
+            ncon++;
+            npoints += cs->items[i].m.count;
+        }
+    /* one block: constraints, then their points packed (most pairs of round
+     * shapes have one point, so a fixed 4 per constraint would waste cache) */
+    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
+                       sizeof(int) * (size_t)(3 * ncon + 2 * nb + 4);
     if (!ensure_capacity(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
     contact_constraint *cc = s->constraints;
-    int *order = (int *)(cc + ncon);
+    constraint_point *point_pool = (constraint_point *)(cc + ncon);
+    int *order = (int *)(point_pool + npoints);
     int *level = order + ncon;
     int *count_buf = level + nb + 1;
 
@@ -364,6 +371,8 @@ int world_solve(carom_world *w, double dt)
         c->b = bs->solver_index[sb];
         c->contact = i;
         c->count = ct->m.count;
+        c->p = point_pool;
+        point_pool += c->count;
         c->n = ct->m.normal;
         /* keep the friction basis stable across steps while the normal holds still */
         vec3 t1 = v3_sub(ct->tangent1, v3_scale(c->n, v3_dot(ct->tangent1, c->n)));

@@ -32,7 +32,7 @@ typedef struct contact_constraint {
     vec3 n, t1, t2;
     double friction, restitution;
     softness soft;
-    constraint_point p[MANIFOLD_MAX_POINTS];
+    constraint_point *p;         /* count points in the step's packed point array */
 } contact_constraint;
 
 softness make_softness(double hertz, double damping_ratio, double h);
