@@ -34,3 +34,6 @@ echo "== scaling: pile of 100 to 50,000 bodies"
 lua5.4 plot_scaling.lua out/scaling.csv out/scaling.svg
 echo
 echo "bench: results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto_*.svg, scaling.svg)"
+echo
+echo "== narrowphase cost per pair type"
+../build/bench/bench_narrowphase | tee out/narrowphase.txt
