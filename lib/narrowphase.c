@@ -361,11 +361,14 @@ static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip
     }
     clip_vertex *in = buf1, *out = buf2;
     int rc = ref->fcount[rf];
+    /* parallel faces (a stack): a vertex just outside a side plane is as deep
+     * as the ones inside, and keeping it keeps the ids steady under jitter */
+    double tol = 1.0 + best < 1e-8 ? CLIP_TOLERANCE : 0.0;
     for (int e = 0; e < rc && nbuf > 0; e++) {
         vec3 a = ref->v[ref->fv[ref->ffirst[rf] + e]], b = ref->v[ref->fv[ref->ffirst[rf] + (e + 1) % rc]];
         vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
         if (nbuf + 1 > CLIP_MAX) break;
-        nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a) + CLIP_TOLERANCE, (uint32_t)(e & 0xff), out);
+        nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a) + tol, (uint32_t)(e & 0xff), out);
         clip_vertex *t = in; in = out; out = t;
     }
     manifold_point cand[CLIP_MAX];
@@ -590,32 +593,8 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
         double s = dmin(v3_dot(p->fn[f], c0), v3_dot(p->fn[f], c1)) - p->fd[f];
         if (s > best) { best = s; bf = f; }
     }
-    /* nearest feature from outside: the closest point of the polytope boundary
-     * to the core, by edges (covers vertex and edge regions exactly) */
-    double ebest = 1e300;
-    vec3 ep = v3_zero(), ec = v3_zero();
-    int eidx = -1;
-    if (best > 0) {
-        for (int i = 0; i < p->ne; i++) {
-            vec3 pa, pc;
-            closest_segments(p->v[p->e[i][0]], p->v[p->e[i][1]], c0, c1, &pa, &pc);
-            double d2 = v3_len2(v3_sub(pc, pa));
-            if (d2 < ebest) { ebest = d2; ep = pa; ec = pc; eidx = i; }
-        }
-        ebest = sqrt(ebest);
-    }
-    if (best > 0 && eidx >= 0 && ebest > best + 1e-9) {
-        /* the core is outside, nearest to an edge or vertex */
-        vec3 n = any_unit(v3_sub(ec, ep), p->fn[bf]);
-        double sep = ebest - r;
-        m->normal = n;
-        if (sep < spec) add_point(m, v3_madd(ep, 0.5 * sep, n), sep, 0x10000000u | (uint32_t)eidx);
-        return;
-    }
     vec3 n = p->fn[bf];
-    m->normal = n;
-    if (best - r >= spec) return;
-    /* clip the core (point or segment) to the reference face */
+    /* clip the core (point or segment) to the reference face's side planes */
     clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
     int nb = seg ? 2 : 1;
     b1[0].p = c0; b1[0].id = 0;
@@ -634,8 +613,29 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
         }
         clip_vertex *t = in; in = out; out = t;
     }
+    if (best > 0 && nb == 0) {
+        /* outside, and the core does not project onto the face: the nearest
+         * feature is an edge or a vertex */
+        double ebest = 1e300;
+        vec3 ep = v3_zero(), ec = v3_zero();
+        int eidx = 0;
+        for (int i = 0; i < p->ne; i++) {
+            vec3 pa, pc;
+            closest_segments(p->v[p->e[i][0]], p->v[p->e[i][1]], c0, c1, &pa, &pc);
+            double d2 = v3_len2(v3_sub(pc, pa));
+            if (d2 < ebest) { ebest = d2; ep = pa; ec = pc; eidx = i; }
+        }
+        ebest = sqrt(ebest);
+        vec3 en = any_unit(v3_sub(ec, ep), n);
+        double sep = ebest - r;
+        m->normal = en;
+        if (sep < spec) add_point(m, v3_madd(ep, 0.5 * sep, en), sep, 0x10000000u | (uint32_t)eidx);
+        return;
+    }
+    m->normal = n;
+    if (best - r >= spec) return;
     if (nb == 0) {
-        /* the core projects outside the face: use its deepest end */
+        /* overlapping but the core projects outside the face: its deepest end */
         nb = 1;
         in[0].p = v3_dot(n, c0) <= v3_dot(n, c1) ? c0 : c1;
         in[0].id = 0;
