@@ -121,8 +121,10 @@ CAROM_API carom_status carom_world_def_apply_preset(carom_world_def *def, const 
         d.substeps = 4; d.iterations = 1; d.relax_iterations = 1;
         d.contact_hertz = 30.0; d.contact_damping_ratio = 10.0;
     } else if (strcmp(preset, "fast") == 0) {
-        d.substeps = 2; d.iterations = 1; d.relax_iterations = 1;
-        d.contact_hertz = 15.0; d.contact_damping_ratio = 10.0;
+        /* the sweep's cheapest point that keeps the pyramid standing: no relax
+         * pass (2 sub-steps at 15 Hz, tried first, let stacks sink 0.1-0.4 m) */
+        d.substeps = 4; d.iterations = 1; d.relax_iterations = 0;
+        d.contact_hertz = 30.0; d.contact_damping_ratio = 10.0;
     } else if (strcmp(preset, "accurate") == 0) {
         d.substeps = 8; d.iterations = 2; d.relax_iterations = 1;
         d.contact_hertz = 60.0; d.contact_damping_ratio = 10.0;
