@@ -37,3 +37,6 @@ echo "bench: results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto
 echo
 echo "== narrowphase cost per pair type"
 ../build/bench/bench_narrowphase | tee out/narrowphase.txt
+echo
+echo "== the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
+../build/bench/extremes 1000000 | tee out/extremes.txt
