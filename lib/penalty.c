@@ -38,12 +38,7 @@ void penalty_solve(carom_world *w, contact_constraint *cc, int n, double h)
             vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
             double l1 = -p->tangent_mass[0] * v3_dot(vp, c->t1);
             double l2 = -p->tangent_mass[1] * v3_dot(vp, c->t2);
-            double limit = c->friction * impulse, mag2 = l1 * l1 + l2 * l2;
-            if (mag2 > limit * limit) {
-                double f = limit / sqrt(mag2);
-                l1 *= f;
-                l2 *= f;
-            }
+            coulomb_clamp(&l1, &l2, c->friction * impulse);
             p->tangent_impulse[0] = l1;
             p->tangent_impulse[1] = l2;
             impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, l1), v3_scale(c->t2, l2)));

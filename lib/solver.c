@@ -93,14 +93,7 @@ static void solve_constraint(contact_constraint *c, const solve_context *sc, int
             double v2 = v3_dot(dv, c->t2) + v3_dot(wB, p->rb_t[1]) - v3_dot(wA, p->ra_t[1]);
             double n1 = o1 - p->tangent_mass[0] * v1;
             double n2 = o2 - p->tangent_mass[1] * v2;
-            /* Coulomb cone: |friction| <= mu * normal impulse */
-            double limit = c->friction * p->normal_impulse;
-            double mag2 = n1 * n1 + n2 * n2;
-            if (mag2 > limit * limit) {
-                double k = limit / sqrt(mag2);
-                n1 *= k;
-                n2 *= k;
-            }
+            coulomb_clamp(&n1, &n2, c->friction * p->normal_impulse);
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
             double d1 = n1 - o1, d2 = n2 - o2;
@@ -164,12 +157,7 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         /* Coulomb on the total: what the regular pass used plus this pass */
         double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
         double t1 = o1 + nw[0], t2 = o2 + nw[1];
-        double limit = c->friction * dmax(p->normal_impulse + p->shock_normal, 0.0), mag2 = t1 * t1 + t2 * t2;
-        if (mag2 > limit * limit) {
-            double f = limit / sqrt(mag2);
-            t1 *= f;
-            t2 *= f;
-        }
+        coulomb_clamp(&t1, &t2, c->friction * dmax(p->normal_impulse + p->shock_normal, 0.0));
         vec3 P = v3_add(v3_scale(t[0], t1 - o1), v3_scale(t[1], t2 - o2));
         A->v = v3_madd(A->v, -fa * A->inv_mass, P);
         A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
@@ -217,12 +205,7 @@ static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodie
             vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
             double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
             double n1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1), n2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
-            double limit = c->friction * p->normal_impulse, mag2 = n1 * n1 + n2 * n2;
-            if (mag2 > limit * limit) {
-                double f = limit / sqrt(mag2);
-                n1 *= f;
-                n2 *= f;
-            }
+            coulomb_clamp(&n1, &n2, c->friction * p->normal_impulse);
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
             impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2)));

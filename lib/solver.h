@@ -36,6 +36,17 @@ typedef struct contact_constraint {
 } contact_constraint;
 
 softness make_softness(double hertz, double damping_ratio, double h);
+
+/* Coulomb's cone: scales the friction impulse (t1, t2) back to |t| <= limit. */
+static inline void coulomb_clamp(double *t1, double *t2, double limit)
+{
+    double mag2 = *t1 * *t1 + *t2 * *t2;
+    if (mag2 > limit * limit) {
+        double f = limit / sqrt(mag2);
+        *t1 *= f;
+        *t2 *= f;
+    }
+}
 /* Penalty springs: one sub-step of spring forces (penalty.c). */
 void penalty_solve(carom_world *w, contact_constraint *cc, int n, double h);
 
