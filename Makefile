@@ -16,7 +16,11 @@ CCD_LIBS    := $(if $(PKGCONFIG),$(shell pkg-config --libs ccd 2>/dev/null),-lcc
 LUA_CFLAGS  := $(if $(PKGCONFIG),$(shell pkg-config --cflags lua5.4 2>/dev/null))
 LUA_LIBS    := $(if $(PKGCONFIG),$(shell pkg-config --libs lua5.4 2>/dev/null),-llua5.4)
 CMOCKA_LIBS := $(if $(PKGCONFIG),$(shell pkg-config --libs cmocka 2>/dev/null),-lcmocka)
-LUA_CMOD    := $(shell pkg-config --variable=INSTALL_CMOD lua5.4 2>/dev/null)
+# The Lua module goes where Lua 5.4 looks: Debian's directory for PREFIX=/usr,
+# else $(PREFIX)/lib/lua/5.4 (on Lua's default cpath for /usr/local).
+ifeq ($(PREFIX),/usr)
+LUA_CMOD := $(shell pkg-config --variable=INSTALL_CMOD lua5.4 2>/dev/null)
+endif
 ifeq ($(LUA_CMOD),)
 LUA_CMOD := $(PREFIX)/lib/lua/5.4
 endif
