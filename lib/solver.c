@@ -562,8 +562,9 @@ int world_solve(carom_world *w, double dt)
             av = m3_mulv(bs->inv_inertia_world[slot], L);
             if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));
             bs->angular_velocity[slot] = av;
+        } else {
+            body_update_inertia(bs, slot);
         }
-        body_update_inertia(bs, slot);
         awake++;
     }
     w->stats.clamped += clamped;
