@@ -159,6 +159,12 @@ CAROM_API carom_world *carom_world_create(const carom_world_def *def)
 CAROM_API void carom_world_destroy(carom_world *w)
 {
     if (!w) return;
+    if (w->locked) {
+        /* from inside its own step (an event callback): refusing is the only
+         * safe answer; the caller can destroy it after the step returns */
+        world_fail(w, CAROM_ERROR_LOCKED, "world_destroy: the world is inside its step; destroy it afterwards");
+        return;
+    }
     for (int i = 0; i < w->bodies.count; i++) hull_free(w->bodies.shapes[i].hull);
     body_store_free(&w->bodies);
     if (w->bp) bp_destroy(w->bp);

@@ -385,7 +385,7 @@ static void test_world_def_validation(void **state)
 
 typedef struct callback_probe {
     carom_world *w;
-    int calls, create_refused, step_refused, destroy_ok;
+    int calls, create_refused, step_refused, destroy_ok, world_destroy_refused;
     carom_body_id victim;
 } callback_probe;
 
@@ -398,6 +398,8 @@ static void on_event(void *ctx, const carom_contact_event *e)
     if (carom_body_id_is_null(carom_body_create(p->w, &d))) p->create_refused++;
     if (carom_world_step(p->w, 0.01) == CAROM_ERROR_LOCKED) p->step_refused++;
     if (carom_body_destroy(p->w, p->victim) == CAROM_OK) p->destroy_ok++;
+    carom_world_destroy(p->w); /* refused: the world is inside its step */
+    if (strstr(carom_world_last_error(p->w), "inside its step")) p->world_destroy_refused++;
 }
 
 static void test_mutation_inside_callback(void **state)
@@ -420,6 +422,7 @@ static void test_mutation_inside_callback(void **state)
     assert_true(probe.calls > 0);
     assert_int_equal(probe.create_refused, probe.calls);
     assert_int_equal(probe.step_refused, probe.calls);
+    assert_int_equal(probe.world_destroy_refused, probe.calls);
     /* the destroy was deferred to the end of the step, and happened */
     assert_true(probe.destroy_ok > 0);
     assert_false(carom_body_is_valid(w, ball));

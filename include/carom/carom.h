@@ -179,6 +179,7 @@ CAROM_API carom_status carom_world_def_check(const carom_world_def *def, char *m
 
 /* NULL when def is invalid (carom_world_def_check says why) or out of memory. */
 CAROM_API carom_world *carom_world_create(const carom_world_def *def);
+/* Refused (with an error message) when called from inside the world's own step. */
 CAROM_API void carom_world_destroy(carom_world *world);
 /* Message of the last failed call on this world ("" if none). */
 CAROM_API const char *carom_world_last_error(const carom_world *world);
