@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "narrowphase.h"
 
 #define AABB_MARGIN 0.1   /* fat AABB margin (m): bodies move this far before re-insertion */
 #define MAX_COORDINATE 1e12
@@ -181,6 +182,16 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
         sh.hull = hull_build(d.shape.points, d.shape.point_count, err, (int)sizeof err);
         if (!sh.hull) {
             world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: bad hull: %s", err);
+            return null_id;
+        }
+        int fv = 0;
+        for (int f = 0; f < sh.hull->face_count; f++) fv += sh.hull->faces[f].count;
+        if (sh.hull->vertex_count > HULL_MAX_VERTICES || sh.hull->face_count > HULL_MAX_FACES ||
+            fv > HULL_MAX_FACE_VERTICES || sh.hull->edge_count > HULL_MAX_FACE_VERTICES / 2) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                       "body_create: hull has %d vertices and %d faces; at most %d and %d (simplify the point set)",
+                       sh.hull->vertex_count, sh.hull->face_count, HULL_MAX_VERTICES, HULL_MAX_FACES);
+            hull_free(sh.hull);
             return null_id;
         }
     }

@@ -7,9 +7,9 @@
 #include <ccd/ccd.h>
 #include "manifold.h"
 
-#define POLY_MAX_V 256
-#define POLY_MAX_F 256
-#define POLY_MAX_FV 1024
+#define POLY_MAX_V HULL_MAX_VERTICES
+#define POLY_MAX_F HULL_MAX_FACES
+#define POLY_MAX_FV HULL_MAX_FACE_VERTICES
 #define CYL_SIDES 16
 #define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
 #define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */
@@ -109,7 +109,9 @@ static int poly_from_shape(poly *p, const shape *s, xform x)
     switch (s->type) {
     case SHAPE_BOX: poly_from_box(p, s->half_extents, x); return 1;
     case SHAPE_HULL:
-        if (s->hull->vertex_count > POLY_MAX_V || s->hull->face_count > POLY_MAX_F) return 0;
+        if (s->hull->vertex_count > POLY_MAX_V || s->hull->face_count > POLY_MAX_F ||
+            s->hull->edge_count > POLY_MAX_FV / 2)
+            return 0; /* cannot happen: body creation rejects such hulls */
         poly_from_hull(p, s->hull, x);
         return 1;
     case SHAPE_CYLINDER: poly_from_cylinder(p, s->radius, s->half_height, x); return 1;

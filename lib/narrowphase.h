@@ -8,6 +8,10 @@
 #include "shape.h"
 
 #define MANIFOLD_MAX_POINTS 4
+/* Hulls the narrowphase can hold on its stack (body creation rejects larger ones). */
+#define HULL_MAX_VERTICES 256
+#define HULL_MAX_FACES 256
+#define HULL_MAX_FACE_VERTICES 1024
 
 typedef struct manifold_point {
     vec3 point;          /* world point, midway between the two surfaces */

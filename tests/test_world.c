@@ -277,6 +277,15 @@ static void test_rejections_leave_world_unchanged(void **state)
         static const double flat[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0.5, 0.5, 0};
         REJECT_DEF(d.shape = carom_shape_hull(flat, 5), "coplanar hull");
     }
+    {
+        /* a hull finer than the narrowphase holds (points on a sphere) is refused, not ignored */
+        static double ball[3 * 2000];
+        for (int i = 0; i < 2000; i++) {
+            double z = 1.0 - 2.0 * (i + 0.5) / 2000, r = sqrt(1 - z * z), a = 2.399963229728653 * i;
+            ball[3 * i] = r * cos(a); ball[3 * i + 1] = r * sin(a); ball[3 * i + 2] = z;
+        }
+        REJECT_DEF(d.shape = carom_shape_hull(ball, 2000), "hull with too many vertices");
+    }
     REJECT_DEF(d.friction = -0.1, "negative friction");
     REJECT_DEF(d.restitution = 1.5, "restitution above 1");
     REJECT_DEF(d.type = (carom_body_type)7, "unknown body type");
