@@ -279,7 +279,7 @@ static void test_rejections_leave_world_unchanged(void **state)
     }
     {
         /* a hull finer than the narrowphase holds (points on a sphere) is refused, not ignored */
-        static double ball[3 * 2000];
+        double ball[3 * 2000];
         for (int i = 0; i < 2000; i++) {
             double z = 1.0 - 2.0 * (i + 0.5) / 2000, r = sqrt(1 - z * z), a = 2.399963229728653 * i;
             ball[3 * i] = r * cos(a); ball[3 * i + 1] = r * sin(a); ball[3 * i + 2] = z;
