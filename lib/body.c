@@ -105,7 +105,10 @@ int body_store_slot(const body_store *s, uint32_t index1, uint32_t generation)
 
 vec3 body_origin(const body_store *s, int slot)
 {
-    return v3_sub(s->center[slot], q_rotate(s->rotation[slot], s->local_center[slot]));
+    vec3 lc = s->local_center[slot];
+    /* most shapes are centred on their origin: skip the rotation */
+    if (lc.x == 0.0 && lc.y == 0.0 && lc.z == 0.0) return s->center[slot];
+    return v3_sub(s->center[slot], q_rotate(s->rotation[slot], lc));
 }
 
 xform body_xform(const body_store *s, int slot)

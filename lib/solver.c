@@ -391,9 +391,11 @@ int world_solve(carom_world *w, double dt)
                 p->ia_t[q] = m3_mulv(A->inv_inertia, p->ra_t[q]);
                 p->ib_t[q] = m3_mulv(B->inv_inertia, p->rb_t[q]);
             }
-            double kn = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->n);
-            double k1 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t1);
-            double k2 = impulse_inverse_effective_mass(B, A, p->rb, p->ra, c->t2);
+            /* the seed's denominator 1/m1 + 1/m2 + n.((I1^-1 (r1 x n)) x r1) + ..., from the
+             * rows above: n.((I^-1 (r x n)) x r) = (I^-1 (r x n)).(r x n) */
+            double kn = A->inv_mass + B->inv_mass + v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
+            double k1 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
+            double k2 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
             p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
             p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
             p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
