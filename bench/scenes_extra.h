@@ -11,6 +11,7 @@ typedef struct scene_result {
     double error;            /* the scene's error metric (lower is better) */
     const char *error_name;
     double extra;            /* a second number (scene-specific, see error_name) */
+    double momentum_drift;   /* |p_end - p_start| / |p_start| where nothing external acts; -1 elsewhere */
 } scene_result;
 
 static carom_vec3 sx_vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
@@ -86,6 +87,7 @@ static int canonical_run(const char *name, const carom_world_def *def, double *m
     if (sc.id == SC_BULLET && !sc.ccd) d.enable_continuous = 0;
     carom_world *w = carom_world_create(&d);
     if (!w) { scene_free(&sc); return 0; }
+    r->momentum_drift = -1;
     carom_body_id *ids = malloc(sizeof *ids * (size_t)sc.nbodies);
     canonical_build(w, &sc, ids);
     double t0 = bench_now_ms();
@@ -144,6 +146,7 @@ static int analytic_run(const char *name, const carom_world_def *def, double *ms
     double t0, elapsed = 0;
     carom_world *w = NULL;
     r->extra = 0;
+    r->momentum_drift = -1;
     if (!strcmp(name, "bounce")) {
         /* e = 0.5 from 1 m: apex e^2 h = 0.25 m */
         w = carom_world_create(&d);
@@ -258,10 +261,18 @@ static int analytic_run(const char *name, const carom_world_def *def, double *ms
             steps = 600;
         }
         carom_world_get_energy(w, &ke0, &pe);
+        carom_vec3 p0, p1;
+        carom_world_get_momentum(w, &p0, NULL);
         t0 = bench_now_ms();
         for (int s = 0; s < steps; s++) carom_world_step(w, dt);
         elapsed = bench_now_ms() - t0;
         carom_world_get_energy(w, &ke1, &pe);
+        carom_world_get_momentum(w, &p1, NULL);
+        if (cradle) {
+            /* walls are absent: total momentum is conserved exactly */
+            double m0 = sqrt(p0.x * p0.x + p0.y * p0.y + p0.z * p0.z);
+            r->momentum_drift = sqrt(pow(p1.x - p0.x, 2) + pow(p1.y - p0.y, 2) + pow(p1.z - p0.z, 2)) / m0;
+        }
         if (cradle) {
             carom_vec3 v;
             carom_body_get_linear_velocity(w, last, &v);

@@ -2,7 +2,7 @@
  * of a sweep over the solver knobs, runs the scene, takes the median ms/step
  * over several runs and the scene's error metric, and writes one CSV row:
  *   scene,knob,value,substeps,iterations,relax,correction,warm,model,ccd,friction,
- *   ms_step,error,error_name,extra
+ *   ms_step,error,error_name,extra,momentum_drift (empty where external forces act)
  * Usage: sweep [--quick] [--runs N] [--scenes a,b,...] > out.csv */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
@@ -33,10 +33,12 @@ static const char *correction_name(carom_position_correction c)
 static void emit(const char *scene, const knobs *k, double ms, const scene_result *r)
 {
     const carom_world_def *d = &k->def;
-    printf("%s,%s,%s,%d,%d,%d,%s,%d,%s,%d,%d,%.6f,%.6g,%s,%.6g\n", scene, k->knob, k->value, d->substeps,
+    char drift[32] = "";
+    if (r->momentum_drift >= 0) snprintf(drift, sizeof drift, "%.3g", r->momentum_drift);
+    printf("%s,%s,%s,%d,%d,%d,%s,%d,%s,%d,%d,%.6f,%.6g,%s,%.6g,%s\n", scene, k->knob, k->value, d->substeps,
            d->iterations, d->relax_iterations, correction_name(d->position_correction), d->warm_starting,
            d->contact_model == CAROM_CONTACT_IMPULSE ? "impulse" : "penalty", d->enable_continuous,
-           d->enable_friction, ms, r->error, r->error_name, r->extra);
+           d->enable_friction, ms, r->error, r->error_name, r->extra, drift);
     fflush(stdout);
 }
 
@@ -66,7 +68,7 @@ int main(int argc, char **argv)
         else { fprintf(stderr, "usage: sweep [--quick] [--runs N] [--scenes a,b]\n"); return 2; }
     }
     if (runs < 1) runs = 1;
-    printf("scene,knob,value,substeps,iterations,relax,correction,warm,model,ccd,friction,ms_step,error,error_name,extra\n");
+    printf("scene,knob,value,substeps,iterations,relax,correction,warm,model,ccd,friction,ms_step,error,error_name,extra,momentum_drift\n");
     static const int substeps[] = {1, 2, 4, 8};
     static const int iterations[] = {1, 2, 4, 8, 16};
     for (int s = 0; s < extra_scene_count(); s++) {
