@@ -25,10 +25,28 @@ typedef struct poly {
     int ffirst[POLY_MAX_F], fcount[POLY_MAX_F];
     int fv[POLY_MAX_FV];
     int e[POLY_MAX_FV / 2][2];
+    int ef[POLY_MAX_FV / 2][2];      /* the two faces beside each edge (Gauss-map arcs) */
     vec3 center;
 } poly;
 
 /* ---- building polytopes ------------------------------------------------------- */
+
+/* Faces beside each edge, by matching face boundary segments to edges. */
+static void poly_edge_faces(poly *p)
+{
+    for (int i = 0; i < p->ne; i++) p->ef[i][0] = p->ef[i][1] = -1;
+    for (int f = 0; f < p->nf; f++) {
+        int n = p->fcount[f], first = p->ffirst[f];
+        for (int k = 0; k < n; k++) {
+            int u = p->fv[first + k], v = p->fv[first + (k + 1) % n];
+            for (int i = 0; i < p->ne; i++)
+                if ((p->e[i][0] == u && p->e[i][1] == v) || (p->e[i][0] == v && p->e[i][1] == u)) {
+                    p->ef[i][p->ef[i][0] < 0 ? 0 : 1] = f;
+                    break;
+                }
+        }
+    }
+}
 
 static void poly_finish(poly *p)
 {
@@ -125,13 +143,6 @@ static double poly_min_along(const poly *p, vec3 n)
 {
     double m = v3_dot(p->v[0], n);
     for (int i = 1; i < p->nv; i++) m = dmin(m, v3_dot(p->v[i], n));
-    return m;
-}
-
-static double poly_max_along(const poly *p, vec3 n)
-{
-    double m = v3_dot(p->v[0], n);
-    for (int i = 1; i < p->nv; i++) m = dmax(m, v3_dot(p->v[i], n));
     return m;
 }
 
@@ -449,20 +460,33 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
         if (s > sb_best) { sb_best = s; fb = f; }
     }
     if (sb_best > spec) { m->normal = v3_neg(pb->fn[fb]); return; }
-    /* edge pairs */
+    /* edge pairs: only those whose Gauss-map arcs cross (they bound a face of
+     * the Minkowski difference); for them the edges' own points give the
+     * separation, no vertex loop needed (Gregorius, GDC 2013) */
     double se_best = -1e300;
     int ea = -1, eb = -1;
     vec3 en = v3_zero();
+    poly_edge_faces(pa); /* only this path needs the adjacency */
+    poly_edge_faces(pb);
     for (int i = 0; i < pa->ne; i++) {
+        if (pa->ef[i][0] < 0 || pa->ef[i][1] < 0) continue;
         vec3 a0 = pa->v[pa->e[i][0]], da = v3_sub(pa->v[pa->e[i][1]], a0);
+        vec3 na = pa->fn[pa->ef[i][0]], nb = pa->fn[pa->ef[i][1]];
+        vec3 bxa = v3_cross(nb, na);
         for (int j = 0; j < pb->ne; j++) {
-            vec3 db = v3_sub(pb->v[pb->e[j][1]], pb->v[pb->e[j][0]]);
+            if (pb->ef[j][0] < 0 || pb->ef[j][1] < 0) continue;
+            vec3 nc = v3_neg(pb->fn[pb->ef[j][0]]), nd = v3_neg(pb->fn[pb->ef[j][1]]);
+            vec3 dxc = v3_cross(nd, nc);
+            double cba = v3_dot(nc, bxa), dba = v3_dot(nd, bxa), adc = v3_dot(na, dxc), bdc = v3_dot(nb, dxc);
+            if (!(cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0)) continue;
+            vec3 b0 = pb->v[pb->e[j][0]];
+            vec3 db = v3_sub(pb->v[pb->e[j][1]], b0);
             vec3 ax = v3_cross(da, db);
             double l2 = v3_len2(ax);
             if (l2 < 1e-12 * v3_len2(da) * v3_len2(db)) continue;
             ax = v3_scale(ax, 1.0 / sqrt(l2));
             if (v3_dot(ax, v3_sub(a0, pa->center)) < 0) ax = v3_neg(ax);
-            double s = poly_min_along(pb, ax) - poly_max_along(pa, ax);
+            double s = v3_dot(ax, v3_sub(b0, a0));
             if (s > se_best) { se_best = s; ea = i; eb = j; en = ax; }
             if (s > spec) { m->normal = ax; return; }
         }
