@@ -11,11 +11,10 @@
     X(plane_normal) X(plane_offset) X(sleep_time) X(shapes) X(proxy) X(fat_box) X(user_data) \
     X(solver_index)
 
-static int grow_field(void **p, size_t elem, int old_cap, int new_cap)
+static int grow_field(void **p, size_t elem, int new_cap)
 {
     void *n = realloc(*p, elem * (size_t)new_cap);
     if (!n) return 0;
-    (void)old_cap;
     *p = n;
     return 1;
 }
@@ -23,7 +22,7 @@ static int grow_field(void **p, size_t elem, int old_cap, int new_cap)
 static int body_store_grow(body_store *s, int new_cap)
 {
     int ok = 1;
-#define GROW(f) if (ok && !grow_field((void **)&s->f, sizeof *s->f, s->capacity, new_cap)) ok = 0;
+#define GROW(f) if (ok && !grow_field((void **)&s->f, sizeof *s->f, new_cap)) ok = 0;
     BODY_FIELDS(GROW)
 #undef GROW
     /* Arrays that did grow keep their new size; capacity only counts when all did. */

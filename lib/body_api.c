@@ -6,7 +6,6 @@
 #include "world.h"
 #include "narrowphase.h"
 
-#define AABB_MARGIN 0.1   /* fat AABB margin (m): bodies move this far before re-insertion */
 #define MAX_COORDINATE 1e12
 
 static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
@@ -75,7 +74,7 @@ void world_remove_body_contacts(carom_world *w, int id_index)
 
 static void refresh_proxy(carom_world *w, int slot)
 {
-    aabb fat = world_body_fat_aabb(w, slot, AABB_MARGIN);
+    aabb fat = world_body_fat_aabb(w, slot, WORLD_AABB_MARGIN);
     w->bodies.fat_box[slot] = fat;
     bp_move_proxy(w->bp, w->bodies.proxy[slot], fat);
 }
@@ -246,7 +245,7 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
         s->angular_velocity[slot] = v3_scale(n, v3_dot(s->angular_velocity[slot], n));
     }
     body_update_inertia(s, slot);
-    aabb fat = world_body_fat_aabb(w, slot, AABB_MARGIN);
+    aabb fat = world_body_fat_aabb(w, slot, WORLD_AABB_MARGIN);
     s->fat_box[slot] = fat;
     s->proxy[slot] = bp_create_proxy(w->bp, fat, d.type == CAROM_BODY_STATIC, id_index);
     if (s->proxy[slot] < 0) {

@@ -5,8 +5,6 @@
 #include <string.h>
 #include "world.h"
 
-#define AABB_MARGIN 0.1
-
 static void add_pair(void *ctx, int ida, int idb)
 {
     carom_world *w = ctx;
@@ -34,12 +32,12 @@ void world_update_pairs(carom_world *w)
         /* bullets and fast bodies: the box covers this step's travel so their
          * speculative contacts exist before they arrive */
         vec3 travel = v3_scale(s->velocity[i], dt);
-        if (v3_len2(travel) > 0.25 * AABB_MARGIN * AABB_MARGIN) {
+        if (v3_len2(travel) > 0.25 * WORLD_AABB_MARGIN * WORLD_AABB_MARGIN) {
             box.lo = v3_min(box.lo, v3_add(box.lo, travel));
             box.hi = v3_max(box.hi, v3_add(box.hi, travel));
         }
         if (!aabb_contains(s->fat_box[i], box)) {
-            aabb fat = aabb_fatten(box, AABB_MARGIN);
+            aabb fat = aabb_fatten(box, WORLD_AABB_MARGIN);
             s->fat_box[i] = fat;
             bp_move_proxy(w->bp, s->proxy[i], fat);
         }
@@ -84,7 +82,7 @@ void world_collide(carom_world *w)
         /* a fast pair looks ahead by its closing travel this step */
         double spec = speculative;
         double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
-        if (closing > spec) spec = dmin(closing, speculative + 4.0 * AABB_MARGIN);
+        if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
         manifold old_m = c->m;
         contact_point_state old_state[MANIFOLD_MAX_POINTS];
         memcpy(old_state, c->state, sizeof old_state);

@@ -418,7 +418,7 @@ static void ccd_center(const void *obj, ccd_vec3_t *out)
 }
 
 /* libccd MPR on the true shapes: the penetration direction (a to b), or 0. */
-static int ccd_normal(const shape *a, xform xa, const shape *b, xform xb, const collide_cache *cache, vec3 *n)
+static int ccd_normal(const shape *a, xform xa, const shape *b, xform xb, vec3 *n)
 {
     ccd_t ccd;
     CCD_INIT(&ccd);
@@ -430,7 +430,7 @@ static int ccd_normal(const shape *a, xform xa, const shape *b, xform xb, const 
     ccd.epa_tolerance = 1e-10;
     ccd.mpr_tolerance = 1e-10;
     ccd.dist_tolerance = 1e-10;
-    (void)cache; /* MPR seeds itself from the centres */
+    /* MPR seeds its search from the centres (no first direction to give) */
     ccd_obj oa = {a, xa}, ob = {b, xb};
     ccd_real_t depth;
     ccd_vec3_t dir, pos;
@@ -507,7 +507,7 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
         /* the prism's facets only approximate a round side: ask libccd about the
          * true cylinder and take the face most aligned with its normal */
         vec3 n;
-        if (sa_best < 0 && sb_best < 0 && ccd_normal(sa, xa, sb, xb, cache, &n)) {
+        if (sa_best < 0 && sb_best < 0 && ccd_normal(sa, xa, sb, xb, &n)) {
             double best_a = -2, best_b = -2;
             int ia = fa, ib = fb;
             for (int f = 0; f < pa->nf; f++) if (v3_dot(pa->fn[f], n) > best_a) { best_a = v3_dot(pa->fn[f], n); ia = f; }

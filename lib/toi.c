@@ -102,7 +102,7 @@ void world_continuous(carom_world *w, double dt)
         if (q.best_t < 1.0) {
             s->center[i] = v3_madd(q.start, q.best_t, delta);
             w->stats.toi_events++;
-            aabb fat = aabb_fatten(shape_aabb(&s->shapes[i], body_xform(s, i)), 0.1 + w->def.speculative_distance);
+            aabb fat = aabb_fatten(shape_aabb(&s->shapes[i], body_xform(s, i)), WORLD_AABB_MARGIN + w->def.speculative_distance);
             s->fat_box[i] = fat;
             bp_move_proxy(w->bp, s->proxy[i], fat);
         }

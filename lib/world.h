@@ -10,6 +10,8 @@
 #include "impulse.h"
 
 #define WORLD_ERROR_SIZE 256
+/* Fat AABB margin (m): a body moves this far before its proxy is re-inserted. */
+#define WORLD_AABB_MARGIN 0.1
 
 typedef struct event_buffer {
     carom_contact_event *items;
@@ -29,9 +31,6 @@ typedef struct step_scratch {
     int island_capacity;
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
-    vec3 *start_center;         /* continuous collision: pose at step start */
-    quat *start_rotation;
-    int start_capacity;
 } step_scratch;
 
 struct carom_world {

@@ -181,8 +181,6 @@ static void test_round_and_hull_pairs(void **state)
     NEAR(min_sep(&m), -0.01, 1e-12);
     shape s = sphere(0.25);
     run(&s, at(0.3, 0.3, 1.2), &h, at(0, 0, 0), 0.5, &m);                           /* sphere over the slanted face */
-    double plane_d = (1.0 - 0.6) / sqrt(3.0) + 1.2 / sqrt(3.0) - 1.0 / sqrt(3.0);
-    (void)plane_d;
     /* distance from (0.3, 0.3, 1.2) to the plane x + y + z = 1: (1.8 - 1) / sqrt 3 */
     NEAR(m.points[0].separation, 0.8 / sqrt(3.0) - 0.25, 1e-9);
     manifold m2;
