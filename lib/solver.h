@@ -9,19 +9,22 @@ typedef struct softness {
     double bias_rate, mass_scale, impulse_scale;
 } softness;
 
+/* Hot fields first, in the order the solve pass reads them: the normal row,
+ * then the friction rows; what only preparation, restitution or the shock
+ * and penalty paths read comes last. */
 typedef struct constraint_point {
-    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
+    double base_separation;
+    double normal_mass, normal_impulse;
+    double total_normal_impulse, max_normal_impulse;
     vec3 ra_n, rb_n;             /* ra x n, rb x n */
     vec3 ia_n, ib_n;             /* IA^-1 (ra x n), IB^-1 (rb x n) */
+    double tangent_mass[2], tangent_impulse[2];
     vec3 ra_t[2], rb_t[2];       /* ra x t_k, rb x t_k (friction rows) */
     vec3 ia_t[2], ib_t[2];       /* IA^-1 (ra x t_k), IB^-1 (rb x t_k) */
-    double normal_mass, tangent_mass[2];
-    double base_separation;
+    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
     double relative_velocity;    /* normal velocity before solving (restitution) */
-    double normal_impulse, tangent_impulse[2];
-    double total_normal_impulse, max_normal_impulse;
     double penalty_k, penalty_c; /* penalty model spring and damper */
-    double shock_normal, shock_tangent[2]; /* shock pass impulses: this pass only, never warm-started */
+    double shock_normal;         /* shock pass impulse: this pass only, never warm-started */
 } constraint_point;
 
 typedef struct contact_constraint {
