@@ -3,6 +3,7 @@
  * on error. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "world.h"
 #include "narrowphase.h"
 
@@ -264,13 +265,9 @@ CAROM_API carom_status carom_body_destroy(carom_world *w, carom_body_id id)
         step_scratch *sc = &w->scratch;
         for (int i = 0; i < sc->deferred_count; i++)
             if (sc->deferred_destroy[i] == (int)id.index1 - 1) return CAROM_OK;
-        if (sc->deferred_count >= sc->deferred_capacity) {
-            int cap = sc->deferred_capacity ? sc->deferred_capacity * 2 : 16;
-            int *n = realloc(sc->deferred_destroy, sizeof *n * (size_t)cap);
-            if (!n) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_destroy: out of memory");
-            sc->deferred_destroy = n;
-            sc->deferred_capacity = cap;
-        }
+        if (!array_reserve((void **)&sc->deferred_destroy, &sc->deferred_capacity, sc->deferred_count + 1,
+                           sizeof *sc->deferred_destroy))
+            return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_destroy: out of memory");
         sc->deferred_destroy[sc->deferred_count++] = (int)id.index1 - 1;
         return CAROM_OK;
     }

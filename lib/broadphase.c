@@ -5,6 +5,7 @@
  * proxies are never queried against each other. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "broadphase.h"
 
 #define NULL_NODE (-1)
@@ -196,13 +197,7 @@ static void remove_leaf(broadphase *bp, int tree, int leaf)
 static int mark_moved(broadphase *bp, int proxy)
 {
     if (bp->nodes[proxy].moved) return 1;
-    if (bp->move_count >= bp->move_capacity) {
-        int cap = bp->move_capacity ? bp->move_capacity * 2 : 64;
-        int *n = realloc(bp->moved, sizeof *n * (size_t)cap);
-        if (!n) return 0;
-        bp->moved = n;
-        bp->move_capacity = cap;
-    }
+    if (!array_reserve((void **)&bp->moved, &bp->move_capacity, bp->move_count + 1, sizeof *bp->moved)) return 0;
     bp->moved[bp->move_count++] = proxy;
     bp->nodes[proxy].moved = 1;
     return 1;
@@ -211,13 +206,7 @@ static int mark_moved(broadphase *bp, int proxy)
 int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user)
 {
     /* reserve the move-buffer slot and the parent node first, so failure leaves no trace */
-    if (bp->move_count >= bp->move_capacity) {
-        int cap = bp->move_capacity ? bp->move_capacity * 2 : 64;
-        int *n = realloc(bp->moved, sizeof *n * (size_t)cap);
-        if (!n) return -1;
-        bp->moved = n;
-        bp->move_capacity = cap;
-    }
+    if (!array_reserve((void **)&bp->moved, &bp->move_capacity, bp->move_count + 1, sizeof *bp->moved)) return -1;
     int leaf = alloc_node(bp);
     if (leaf == NULL_NODE) return -1;
     int spare = alloc_node(bp);

@@ -1,6 +1,7 @@
 /* contact.c - contact cache: pair hash map and warm-start point matching. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "contact.h"
 
 static uint64_t pair_key(int a, int b)
@@ -108,13 +109,7 @@ int contact_find(const contact_set *cs, int a, int b)
 int contact_add(contact_set *cs, int a, int b)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
-    if (cs->count >= cs->capacity) {
-        int cap = cs->capacity ? cs->capacity * 2 : 64;
-        contact *n = realloc(cs->items, sizeof *n * (size_t)cap);
-        if (!n) return -1;
-        cs->items = n;
-        cs->capacity = cap;
-    }
+    if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);

@@ -5,6 +5,7 @@
  * normal velocity stored before solving, and store impulses for next step. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "solver.h"
 
 #define TWO_PI 6.283185307179586
@@ -21,18 +22,6 @@ softness make_softness(double hertz, double zeta, double h)
     s.mass_scale = a2 * a3;
     s.impulse_scale = a3;
     return s;
-}
-
-static int ensure_capacity(void **p, int *cap, int need, size_t elem)
-{
-    if (need <= *cap) return 1;
-    int n = *cap ? *cap : 64;
-    while (n < need) n *= 2;
-    void *q = realloc(*p, elem * (size_t)n);
-    if (!q) return 0;
-    *p = q;
-    *cap = n;
-    return 1;
 }
 
 typedef struct solve_context {
@@ -285,7 +274,7 @@ int world_solve(carom_world *w, double dt)
     /* gather awake bodies: index 0 is the shared immovable body */
     int nb = 1;
     for (int i = 0; i < bs->count; i++) bs->solver_index[i] = 0;
-    if (!ensure_capacity((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
+    if (!array_reserve((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
     {
         int cap = s->body_capacity;
         /* the per-body scratch arrays share one capacity */
@@ -328,7 +317,7 @@ int world_solve(carom_world *w, double dt)
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
                        sizeof(int) * (size_t)(3 * ncon + 2 * nb + 4);
-    if (!ensure_capacity(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
+    if (!array_reserve(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
     contact_constraint *cc = s->constraints;
     constraint_point *point_pool = (constraint_point *)(cc + ncon);
     int *order = (int *)(point_pool + npoints);

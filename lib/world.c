@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "array.h"
 #include "world.h"
 
 CAROM_API const char *carom_version(void) { return "1.0.0"; }
@@ -207,13 +208,7 @@ CAROM_API int carom_world_body_count(const carom_world *w) { return w ? w->bodie
 int world_push_event(carom_world *w, const carom_contact_event *e)
 {
     event_buffer *b = &w->events;
-    if (b->count >= b->capacity) {
-        int cap = b->capacity ? b->capacity * 2 : 64;
-        carom_contact_event *n = realloc(b->items, sizeof *n * (size_t)cap);
-        if (!n) return 0;
-        b->items = n;
-        b->capacity = cap;
-    }
+    if (!array_reserve((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
     b->items[b->count++] = *e;
     return 1;
 }
