@@ -440,6 +440,37 @@ static void test_mutation_inside_callback(void **state)
     carom_world_destroy(w);
 }
 
+/* Ray casts return the closest hit; AABB queries count exactly the overlapping bodies. */
+static void test_queries(void **state)
+{
+    (void)state;
+    carom_world *w = make_world();
+    carom_body_def d = carom_body_def_default();
+    d.type = CAROM_BODY_STATIC;
+    d.position.x = 5;
+    d.shape = carom_shape_box(1, 1, 1);
+    carom_body_id near_box = carom_body_create(w, &d);
+    d.position.x = 9;
+    d.shape = carom_shape_sphere(1);
+    carom_body_create(w, &d);
+    carom_vec3 o = {0, 0, 0}, t = {20, 0, 0};
+    carom_ray_hit hit;
+    assert_int_equal(carom_world_ray_cast(w, o, t, &hit), 1);
+    assert_true(carom_body_id_equal(hit.body, near_box));
+    assert_true(fabs(hit.fraction - 0.2) < 1e-12 && fabs(hit.point.x - 4) < 1e-12 && hit.normal.x == -1);
+    carom_vec3 up = {0, 0, 20};
+    assert_int_equal(carom_world_ray_cast(w, o, up, &hit), 0);
+    carom_vec3 bad = {NAN, 0, 0};
+    assert_int_equal(carom_world_ray_cast(w, bad, t, &hit), -1);
+    assert_int_equal(carom_world_ray_cast(w, o, t, NULL), -1);
+    carom_vec3 lo = {3.5, -0.5, -0.5}, hi = {9.5, 0.5, 0.5};
+    carom_body_id ids[4];
+    assert_int_equal(carom_world_query_aabb(w, lo, hi, ids, 4), 2);
+    assert_int_equal(carom_world_query_aabb(w, lo, hi, NULL, 0), 2); /* count only */
+    assert_int_equal(carom_world_query_aabb(w, hi, lo, ids, 4), -1);  /* inverted box */
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -450,6 +481,7 @@ int main(void)
         cmocka_unit_test(test_rejections_leave_world_unchanged),
         cmocka_unit_test(test_world_def_validation),
         cmocka_unit_test(test_mutation_inside_callback),
+        cmocka_unit_test(test_queries),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
