@@ -1,8 +1,18 @@
-/* broadphase.c - two dynamic AABB trees (moving and static proxies). Leaves
- * are inserted next to the sibling that least grows the tree's surface area,
- * and AVL-style rotations keep the height logarithmic. A moved-proxy buffer
- * makes pair finding incremental: only moved proxies are queried, and static
- * proxies are never queried against each other. */
+/* broadphase.c - two dynamic AABB trees, one for moving and one for static
+ * proxies, so static geometry is never queried against itself.
+ *
+ * Insertion picks the sibling of least surface-area cost by a greedy branch
+ * and bound descent; on the way back up, each node tries the six swaps of its
+ * children and grandchildren and keeps the one that most reduces surface area
+ * (tree rotations). That also keeps the tree shallow, sorted input included;
+ * only many mutually nested boxes make it deep (a chain: SAH sees no better
+ * tree), which costs time, never correctness.
+ * A moved-proxy buffer makes pair finding incremental: only moved proxies are
+ * queried. Nodes live in one growable pool addressed by index (proxy id =
+ * leaf node index); traversals use explicit stacks, never recursion. */
+#include <assert.h>
+#include <limits.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
@@ -10,22 +20,32 @@
 
 #define NULL_NODE (-1)
 #define LOCAL_STACK 256
+#define CACHE_LINE 64
 
+enum { MOVING_TREE = 0, STATIC_TREE = 1 };
+
+/* Exactly 64 bytes, stored cache-line aligned: a traversal reads one line per node. */
 typedef struct bp_node {
     aabb box;
-    int parent;     /* next free node while on the free list */
-    int left, right;
-    int height;     /* leaf 0, free -1 */
-    int user;
-    int tree;       /* 0 moving, 1 static */
-    int moved;
+    int parent;         /* the next free node while on the free list */
+    int child1, child2; /* NULL_NODE in a leaf */
+    int height;         /* leaf 0, free -1 */
 } bp_node;
 
+/* Per node id, meaningful for leaves (proxies) only: kept out of the hot nodes. */
+typedef struct bp_leaf {
+    int user;
+    int move_slot; /* index in the moved buffer, or -1 */
+    int tree;
+} bp_leaf;
+
 struct broadphase {
-    bp_node *nodes;
-    int capacity, free_list;
+    bp_node *nodes;   /* aligned view into node_block */
+    void *node_block;
+    bp_leaf *leaves;  /* same capacity as nodes */
+    int capacity, free_list, free_count;
     int root[2];
-    int *moved;
+    int *moved;       /* proxies moved or created since the last bp_update_pairs */
     int move_count, move_capacity;
     int proxy_count;
 };
@@ -35,40 +55,59 @@ broadphase *bp_create(void)
     broadphase *bp = calloc(1, sizeof *bp);
     if (!bp) return NULL;
     bp->free_list = NULL_NODE;
-    bp->root[0] = bp->root[1] = NULL_NODE;
+    bp->root[MOVING_TREE] = bp->root[STATIC_TREE] = NULL_NODE;
     return bp;
 }
 
 void bp_destroy(broadphase *bp)
 {
     if (!bp) return;
-    free(bp->nodes);
+    free(bp->node_block);
+    free(bp->leaves);
     free(bp->moved);
     free(bp);
 }
 
+/* Makes at least `need` nodes free. Returns 0 on out of memory, changing nothing visible. */
+static int reserve_nodes(broadphase *bp, int need)
+{
+    if (bp->free_count >= need) return 1;
+    int old = bp->capacity, cap = old ? old : 64;
+    while (cap - old + bp->free_count < need) {
+        if (cap > INT_MAX / 2) return 0;
+        cap *= 2;
+    }
+    bp_leaf *leaves = realloc(bp->leaves, sizeof *leaves * (size_t)cap);
+    if (!leaves) return 0;
+    bp->leaves = leaves; /* larger than needed is harmless if the next step fails */
+    void *block = malloc(sizeof(bp_node) * (size_t)cap + CACHE_LINE - 1);
+    if (!block) return 0;
+    bp_node *nodes = (bp_node *)(((uintptr_t)block + CACHE_LINE - 1) & ~(uintptr_t)(CACHE_LINE - 1));
+    if (old) memcpy(nodes, bp->nodes, sizeof *nodes * (size_t)old);
+    free(bp->node_block);
+    bp->node_block = block;
+    bp->nodes = nodes;
+    /* the new nodes go in front of the free list, lowest index first */
+    for (int i = old; i < cap; i++) {
+        nodes[i].parent = i + 1 < cap ? i + 1 : bp->free_list;
+        nodes[i].height = -1;
+    }
+    bp->free_list = old;
+    bp->free_count += cap - old;
+    bp->capacity = cap;
+    return 1;
+}
+
+/* Only called after reserve_nodes: cannot fail. */
 static int alloc_node(broadphase *bp)
 {
-    if (bp->free_list == NULL_NODE) {
-        int cap = bp->capacity ? bp->capacity * 2 : 64;
-        bp_node *n = realloc(bp->nodes, sizeof *n * (size_t)cap);
-        if (!n) return NULL_NODE;
-        bp->nodes = n;
-        for (int i = bp->capacity; i < cap; i++) {
-            n[i].parent = i + 1 < cap ? i + 1 : NULL_NODE;
-            n[i].height = -1;
-        }
-        bp->free_list = bp->capacity;
-        bp->capacity = cap;
-    }
     int id = bp->free_list;
+    assert(id != NULL_NODE);
     bp_node *n = &bp->nodes[id];
     bp->free_list = n->parent;
-    n->parent = n->left = n->right = NULL_NODE;
+    bp->free_count--;
+    n->parent = n->child1 = n->child2 = NULL_NODE;
     n->height = 0;
-    n->user = -1;
-    n->tree = 0;
-    n->moved = 0;
     return id;
 }
 
@@ -77,101 +116,161 @@ static void free_node(broadphase *bp, int id)
     bp->nodes[id].parent = bp->free_list;
     bp->nodes[id].height = -1;
     bp->free_list = id;
+    bp->free_count++;
 }
 
-/* AVL rotation at a: returns the new root of this subtree. */
-static int balance(broadphase *bp, int tree, int ia)
+static int max_int(int a, int b) { return a > b ? a : b; }
+static int is_leaf(const bp_node *n) { return n->child1 == NULL_NODE; }
+
+static double centre_distance2(aabb a, aabb b)
+{
+    return v3_len2(v3_sub(v3_add(a.lo, a.hi), v3_add(b.lo, b.hi)));
+}
+
+/* The node whose new parent (with the leaf) adds the least surface area to the
+ * tree: the parent's area plus every ancestor's growth. Descends greedily into
+ * the child with the lower bound and stops once neither child can beat the best. */
+static int find_best_sibling(const broadphase *bp, int root, aabb box)
+{
+    const bp_node *N = bp->nodes;
+    double leaf_area = aabb_area(box);
+    int best = root;
+    double best_cost = aabb_area(aabb_union(N[root].box, box));
+    double inherited = 0.0; /* growth of the current node and all its ancestors */
+    int i = root;
+    while (!is_leaf(&N[i])) {
+        inherited += aabb_area(aabb_union(N[i].box, box)) - aabb_area(N[i].box);
+        int c[2] = {N[i].child1, N[i].child2};
+        double lower[2];
+        for (int k = 0; k < 2; k++) {
+            double direct = aabb_area(aabb_union(N[c[k]].box, box));
+            double cost = direct + inherited;
+            if (cost < best_cost) {
+                best_cost = cost;
+                best = c[k];
+            }
+            /* a sibling below c[k]: c[k] grows, and the new parent is at least the leaf */
+            lower[k] = is_leaf(&N[c[k]]) ? HUGE_VAL : inherited + direct - aabb_area(N[c[k]].box) + leaf_area;
+        }
+        if (best_cost <= lower[0] && best_cost <= lower[1]) break;
+        int pick;
+        if (lower[0] != lower[1]) pick = lower[0] < lower[1] ? 0 : 1;
+        else pick = centre_distance2(N[c[0]].box, box) <= centre_distance2(N[c[1]].box, box) ? 0 : 1;
+        i = c[pick];
+    }
+    return best;
+}
+
+/* Replaces child `old_child` of node `parent` (or the root) by `new_child`. */
+static void replace_child(broadphase *bp, int tree, int parent, int old_child, int new_child)
 {
     bp_node *N = bp->nodes;
-    bp_node *a = &N[ia];
-    if (a->left == NULL_NODE || a->height < 2) return ia;
-    int ib = a->left, ic = a->right;
-    int bal = N[ic].height - N[ib].height;
-    if (bal > 1 || bal < -1) {
-        /* promote the taller child (c when right-heavy, b when left-heavy) */
-        int up = bal > 1 ? ic : ib, other = bal > 1 ? ib : ic;
-        bp_node *u = &N[up];
-        int iff = u->left, ig = u->right;
-        u->left = ia;
-        u->parent = a->parent;
-        a->parent = up;
-        if (u->parent != NULL_NODE) {
-            if (N[u->parent].left == ia) N[u->parent].left = up;
-            else N[u->parent].right = up;
-        } else {
-            bp->root[tree] = up;
-        }
-        /* the taller grandchild stays under `up`; the shorter one goes to a */
-        int keep = N[iff].height > N[ig].height ? iff : ig, give = keep == iff ? ig : iff;
-        u->right = keep;
-        if (bal > 1) { a->right = give; a->left = other; }
-        else { a->left = give; a->right = other; }
-        N[give].parent = ia;
-        a->box = aabb_union(N[a->left].box, N[a->right].box);
-        a->height = 1 + (N[a->left].height > N[a->right].height ? N[a->left].height : N[a->right].height);
-        u->box = aabb_union(a->box, N[keep].box);
-        u->height = 1 + (a->height > N[keep].height ? a->height : N[keep].height);
-        return up;
-    }
-    return ia;
+    N[new_child].parent = parent;
+    if (parent == NULL_NODE) bp->root[tree] = new_child;
+    else if (N[parent].child1 == old_child) N[parent].child1 = new_child;
+    else N[parent].child2 = new_child;
 }
 
-static void refit_up(broadphase *bp, int tree, int i)
+static void refit(bp_node *N, int i)
+{
+    int a = N[i].child1, b = N[i].child2;
+    N[i].box = aabb_union(N[a].box, N[b].box);
+    N[i].height = 1 + max_int(N[a].height, N[b].height);
+}
+
+/* Puts node x where node y is and y where x was (neither an ancestor of the
+ * other); only the parents' links change, their boxes are refit by the caller. */
+static void exchange(bp_node *N, int x, int y)
+{
+    int px = N[x].parent, py = N[y].parent;
+    if (N[px].child1 == x) N[px].child1 = y;
+    else N[px].child2 = y;
+    if (N[py].child1 == y) N[py].child1 = x;
+    else N[py].child2 = x;
+    N[x].parent = py;
+    N[y].parent = px;
+}
+
+/* Tree rotations (Kensler 2008) at node a with children b = (d, e) and
+ * c = (f, g): exchanging a child with a grandchild on the other side (b<->f,
+ * b<->g, c<->d, c<->e) or two grandchildren (d<->f, d<->g) keeps a's box and
+ * changes only b's and c's. Applies the one that most reduces their summed
+ * surface area, if any does. */
+static void rotate(bp_node *N, int a)
+{
+    if (N[a].height < 2) return;
+    int b = N[a].child1, c = N[a].child2;
+    double area_b = aabb_area(N[b].box), area_c = aabb_area(N[c].box);
+    double best_gain = 0.0;
+    int best_x = NULL_NODE, best_y = NULL_NODE;
+    for (int k = 0; k < 2; k++) {
+        int child = k ? c : b, uncle = k ? b : c;
+        if (is_leaf(&N[uncle])) continue;
+        double uncle_area = k ? area_b : area_c;
+        int g1 = N[uncle].child1, g2 = N[uncle].child2;
+        /* child <-> g1 leaves the uncle holding child and g2 */
+        double gain1 = uncle_area - aabb_area(aabb_union(N[child].box, N[g2].box));
+        double gain2 = uncle_area - aabb_area(aabb_union(N[child].box, N[g1].box));
+        if (gain1 > best_gain) { best_gain = gain1; best_x = child; best_y = g1; }
+        if (gain2 > best_gain) { best_gain = gain2; best_x = child; best_y = g2; }
+    }
+    if (!is_leaf(&N[b]) && !is_leaf(&N[c])) {
+        int d = N[b].child1, e = N[b].child2, f = N[c].child1, g = N[c].child2;
+        /* d <-> f gives b = (f, e), c = (d, g); d <-> g gives b = (g, e), c = (f, d) */
+        double gain_f = area_b + area_c - aabb_area(aabb_union(N[f].box, N[e].box)) -
+                        aabb_area(aabb_union(N[d].box, N[g].box));
+        double gain_g = area_b + area_c - aabb_area(aabb_union(N[g].box, N[e].box)) -
+                        aabb_area(aabb_union(N[f].box, N[d].box));
+        if (gain_f > best_gain) { best_gain = gain_f; best_x = d; best_y = f; }
+        if (gain_g > best_gain) { best_gain = gain_g; best_x = d; best_y = g; }
+    }
+    if (best_x == NULL_NODE) return;
+    exchange(N, best_x, best_y);
+    /* b or c may have moved below the other, but keeps its own children */
+    if (!is_leaf(&N[b])) refit(N, b);
+    if (!is_leaf(&N[c])) refit(N, c);
+    refit(N, a);
+}
+
+/* Refits boxes and heights from node i up, rotating on the way; stops after
+ * the first node whose box and height come out unchanged, as nothing above it
+ * changes (rotating further up bought no measurable quality). */
+static void refit_up(broadphase *bp, int i)
 {
     bp_node *N = bp->nodes;
     while (i != NULL_NODE) {
-        i = balance(bp, tree, i);
-        int l = N[i].left, r = N[i].right;
-        N[i].height = 1 + (N[l].height > N[r].height ? N[l].height : N[r].height);
-        N[i].box = aabb_union(N[l].box, N[r].box);
+        aabb before = N[i].box;
+        int height = N[i].height;
+        refit(N, i);
+        rotate(N, i);
+        if (height == N[i].height && memcmp(&before, &N[i].box, sizeof before) == 0) break;
         i = N[i].parent;
     }
 }
 
-static int insert_leaf(broadphase *bp, int tree, int leaf)
+/* The tree must have a free node reserved for the new parent. */
+static void insert_leaf(broadphase *bp, int tree, int leaf)
 {
-    bp_node *N = bp->nodes;
     if (bp->root[tree] == NULL_NODE) {
         bp->root[tree] = leaf;
-        N[leaf].parent = NULL_NODE;
-        return 1;
+        bp->nodes[leaf].parent = NULL_NODE;
+        return;
     }
-    aabb box = N[leaf].box;
-    int i = bp->root[tree];
-    while (N[i].left != NULL_NODE) {
-        int l = N[i].left, r = N[i].right;
-        double area = aabb_area(N[i].box);
-        double combined = aabb_area(aabb_union(N[i].box, box));
-        double cost = 2.0 * combined, inherit = 2.0 * (combined - area);
-        double cl = aabb_area(aabb_union(N[l].box, box)) + inherit;
-        double cr = aabb_area(aabb_union(N[r].box, box)) + inherit;
-        if (N[l].left != NULL_NODE) cl -= aabb_area(N[l].box);
-        if (N[r].left != NULL_NODE) cr -= aabb_area(N[r].box);
-        if (cost < cl && cost < cr) break;
-        i = cl < cr ? l : r;
-    }
+    int sibling = find_best_sibling(bp, bp->root[tree], bp->nodes[leaf].box);
     int parent = alloc_node(bp);
-    if (parent == NULL_NODE) return 0;
-    N = bp->nodes; /* may have moved */
-    int old_parent = N[i].parent;
-    N[parent].parent = old_parent;
-    N[parent].box = aabb_union(box, N[i].box);
-    N[parent].height = N[i].height + 1;
-    N[parent].left = i;
-    N[parent].right = leaf;
-    N[parent].tree = tree;
-    N[i].parent = parent;
+    bp_node *N = bp->nodes;
+    int old_parent = N[sibling].parent;
+    N[parent].child1 = sibling;
+    N[parent].child2 = leaf;
     N[leaf].parent = parent;
-    if (old_parent != NULL_NODE) {
-        if (N[old_parent].left == i) N[old_parent].left = parent;
-        else N[old_parent].right = parent;
-    } else {
-        bp->root[tree] = parent;
-    }
-    refit_up(bp, tree, N[leaf].parent);
-    return 1;
+    replace_child(bp, tree, old_parent, sibling, parent);
+    N[sibling].parent = parent;
+    refit(N, parent);
+    rotate(N, parent);
+    refit_up(bp, old_parent);
 }
 
+/* Frees the leaf's parent node. */
 static void remove_leaf(broadphase *bp, int tree, int leaf)
 {
     bp_node *N = bp->nodes;
@@ -180,73 +279,99 @@ static void remove_leaf(broadphase *bp, int tree, int leaf)
         return;
     }
     int parent = N[leaf].parent, grand = N[parent].parent;
-    int sibling = N[parent].left == leaf ? N[parent].right : N[parent].left;
-    if (grand != NULL_NODE) {
-        if (N[grand].left == parent) N[grand].left = sibling;
-        else N[grand].right = sibling;
-        N[sibling].parent = grand;
-        free_node(bp, parent);
-        refit_up(bp, tree, grand);
-    } else {
-        bp->root[tree] = sibling;
-        N[sibling].parent = NULL_NODE;
-        free_node(bp, parent);
+    int sibling = N[parent].child1 == leaf ? N[parent].child2 : N[parent].child1;
+    replace_child(bp, tree, grand, parent, sibling);
+    free_node(bp, parent);
+    /* refit only (rotating here costs time and buys no measurable quality),
+     * and stop where nothing changes */
+    for (int i = grand; i != NULL_NODE; i = N[i].parent) {
+        aabb before = N[i].box;
+        int height = N[i].height;
+        refit(N, i);
+        if (height == N[i].height && memcmp(&before, &N[i].box, sizeof before) == 0) break;
     }
 }
 
-static int mark_moved(broadphase *bp, int proxy)
+static void mark_moved(broadphase *bp, int proxy)
 {
-    if (bp->nodes[proxy].moved) return 1;
-    if (!array_reserve((void **)&bp->moved, &bp->move_capacity, bp->move_count + 1, sizeof *bp->moved)) return 0;
+    bp_leaf *l = &bp->leaves[proxy];
+    if (l->move_slot >= 0) return;
+    assert(bp->move_count < bp->move_capacity); /* reserved at creation */
+    l->move_slot = bp->move_count;
     bp->moved[bp->move_count++] = proxy;
-    bp->nodes[proxy].moved = 1;
-    return 1;
+}
+
+static void unmark_moved(broadphase *bp, int proxy)
+{
+    int slot = bp->leaves[proxy].move_slot;
+    if (slot < 0) return;
+    int last = bp->moved[--bp->move_count];
+    bp->moved[slot] = last;
+    bp->leaves[last].move_slot = slot;
+    bp->leaves[proxy].move_slot = -1;
+}
+
+static int is_proxy(const broadphase *bp, int proxy)
+{
+    return bp && proxy >= 0 && proxy < bp->capacity && bp->nodes[proxy].height == 0;
 }
 
 int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user)
 {
-    /* reserve the move-buffer slot and the parent node first, so failure leaves no trace */
-    if (!array_reserve((void **)&bp->moved, &bp->move_capacity, bp->move_count + 1, sizeof *bp->moved)) return -1;
+    /* reserve everything first, so failure leaves no trace; the moved buffer
+     * holds every proxy, so marking one moved never allocates */
+    if (!reserve_nodes(bp, 2)) return -1;
+    if (!array_reserve((void **)&bp->moved, &bp->move_capacity, bp->proxy_count + 1, sizeof *bp->moved)) return -1;
+    int tree = is_static ? STATIC_TREE : MOVING_TREE;
     int leaf = alloc_node(bp);
-    if (leaf == NULL_NODE) return -1;
-    int spare = alloc_node(bp);
-    if (spare == NULL_NODE) { free_node(bp, leaf); return -1; }
-    free_node(bp, spare);
-    int tree = is_static ? 1 : 0;
-    bp_node *n = &bp->nodes[leaf];
-    n->box = box;
-    n->user = user;
-    n->tree = tree;
+    bp->nodes[leaf].box = box;
+    bp->leaves[leaf].user = user;
+    bp->leaves[leaf].move_slot = -1;
+    bp->leaves[leaf].tree = tree;
     insert_leaf(bp, tree, leaf);
-    mark_moved(bp, leaf);
     bp->proxy_count++;
+    mark_moved(bp, leaf);
     return leaf;
 }
 
 void bp_destroy_proxy(broadphase *bp, int proxy)
 {
-    bp_node *n = &bp->nodes[proxy];
-    if (n->moved) {
-        for (int i = 0; i < bp->move_count; i++)
-            if (bp->moved[i] == proxy) bp->moved[i] = NULL_NODE;
-    }
-    remove_leaf(bp, n->tree, proxy);
+    assert(is_proxy(bp, proxy));
+    unmark_moved(bp, proxy);
+    remove_leaf(bp, bp->leaves[proxy].tree, proxy);
     free_node(bp, proxy);
     bp->proxy_count--;
 }
 
 void bp_move_proxy(broadphase *bp, int proxy, aabb box)
 {
-    int tree = bp->nodes[proxy].tree;
+    assert(is_proxy(bp, proxy));
+    int tree = bp->leaves[proxy].tree;
     remove_leaf(bp, tree, proxy);
     bp->nodes[proxy].box = box;
-    insert_leaf(bp, tree, proxy); /* reuses the freed parent node: cannot fail */
+    insert_leaf(bp, tree, proxy); /* takes the parent node just freed: cannot fail */
     mark_moved(bp, proxy);
 }
 
-aabb bp_get_aabb(const broadphase *bp, int proxy) { return bp->nodes[proxy].box; }
-int bp_get_user(const broadphase *bp, int proxy) { return bp->nodes[proxy].user; }
+aabb bp_get_aabb(const broadphase *bp, int proxy)
+{
+    assert(is_proxy(bp, proxy));
+    return bp->nodes[proxy].box;
+}
+
+int bp_get_user(const broadphase *bp, int proxy)
+{
+    assert(is_proxy(bp, proxy));
+    return bp->leaves[proxy].user;
+}
+
 int bp_proxy_count(const broadphase *bp) { return bp->proxy_count; }
+
+int bp_tree_height(const broadphase *bp, int is_static)
+{
+    int root = bp->root[is_static ? STATIC_TREE : MOVING_TREE];
+    return root == NULL_NODE ? -1 : bp->nodes[root].height;
+}
 
 /* Depth-first walk with a local stack that spills to the heap for deep trees. */
 typedef struct walk {
@@ -255,11 +380,23 @@ typedef struct walk {
     int count, capacity;
 } walk;
 
-static void walk_init(walk *w) { w->items = w->local; w->count = 0; w->capacity = LOCAL_STACK; }
-static void walk_free(walk *w) { if (w->items != w->local) free(w->items); }
-static int walk_push(walk *w, int v)
+static void walk_init(walk *w, int root)
 {
-    if (w->count == w->capacity) {
+    w->items = w->local;
+    w->capacity = LOCAL_STACK;
+    w->count = 0;
+    if (root != NULL_NODE) w->items[w->count++] = root;
+}
+
+static void walk_free(walk *w)
+{
+    if (w->items != w->local) free(w->items);
+}
+
+/* Pushes two nodes. Returns 0 on out of memory (the walk then ends early). */
+static int walk_push2(walk *w, int a, int b)
+{
+    if (w->count + 2 > w->capacity) {
         int cap = w->capacity * 2;
         int *n = w->items == w->local ? malloc(sizeof *n * (size_t)cap) : realloc(w->items, sizeof *n * (size_t)cap);
         if (!n) return 0;
@@ -267,38 +404,36 @@ static int walk_push(walk *w, int v)
         w->items = n;
         w->capacity = cap;
     }
-    w->items[w->count++] = v;
+    w->items[w->count++] = a;
+    w->items[w->count++] = b;
     return 1;
 }
 
-typedef struct pair_ctx {
-    broadphase *bp;
-    int self;
-    bp_pair_fn *fn;
-    void *ctx;
-} pair_ctx;
-
-static void query_tree(const broadphase *bp, int tree, aabb box, int self, pair_ctx *pc, bp_query_fn *qfn, void *qctx,
-                       int *stop)
+/* Reports the pairs of moved proxy q with the leaves of one tree. When both
+ * proxies moved, only the lower id reports, so each pair comes once. */
+static void pairs_in_tree(const broadphase *bp, int tree, int q, bp_pair_fn *fn, void *ctx)
 {
-    walk w;
-    walk_init(&w);
-    if (bp->root[tree] != NULL_NODE) walk_push(&w, bp->root[tree]);
     const bp_node *N = bp->nodes;
-    while (w.count > 0 && !*stop) {
+    aabb box = N[q].box;
+    int user = bp->leaves[q].user;
+    int root = bp->root[tree];
+    if (root == NULL_NODE || !aabb_overlap(N[root].box, box)) return;
+    walk w;
+    walk_init(&w, root);
+    /* every node on the stack overlaps the box */
+    while (w.count > 0) {
         int i = w.items[--w.count];
-        if (!aabb_overlap(N[i].box, box)) continue;
-        if (N[i].left != NULL_NODE) {
-            if (!walk_push(&w, N[i].left) || !walk_push(&w, N[i].right)) break;
+        if (is_leaf(&N[i])) {
+            if (i == q || (i < q && bp->leaves[i].move_slot >= 0)) continue;
+            fn(ctx, user, bp->leaves[i].user);
             continue;
         }
-        if (pc) {
-            if (i == self) continue;
-            /* both moved: report once, from the lower proxy */
-            if (N[i].moved && i < self) continue;
-            pc->fn(pc->ctx, N[self].user, N[i].user);
-        } else if (!qfn(qctx, N[i].user)) {
-            *stop = 1;
+        int a = N[i].child1, b = N[i].child2;
+        int oa = aabb_overlap(N[a].box, box), ob = aabb_overlap(N[b].box, box);
+        if (oa && ob) {
+            if (!walk_push2(&w, a, b)) break;
+        } else if (oa || ob) {
+            w.items[w.count++] = oa ? a : b; /* room: one was just popped */
         }
     }
     walk_free(&w);
@@ -308,41 +443,59 @@ void bp_update_pairs(broadphase *bp, bp_pair_fn *fn, void *ctx)
 {
     for (int m = 0; m < bp->move_count; m++) {
         int q = bp->moved[m];
-        if (q == NULL_NODE) continue;
-        pair_ctx pc = {bp, q, fn, ctx};
-        int stop = 0;
-        query_tree(bp, 0, bp->nodes[q].box, q, &pc, NULL, NULL, &stop);
-        if (bp->nodes[q].tree == 0) query_tree(bp, 1, bp->nodes[q].box, q, &pc, NULL, NULL, &stop);
+        pairs_in_tree(bp, MOVING_TREE, q, fn, ctx);
+        if (bp->leaves[q].tree == MOVING_TREE) pairs_in_tree(bp, STATIC_TREE, q, fn, ctx);
     }
-    for (int m = 0; m < bp->move_count; m++)
-        if (bp->moved[m] != NULL_NODE) bp->nodes[bp->moved[m]].moved = 0;
+    for (int m = 0; m < bp->move_count; m++) bp->leaves[bp->moved[m]].move_slot = -1;
     bp->move_count = 0;
 }
 
 void bp_query(const broadphase *bp, aabb box, bp_query_fn *fn, void *ctx)
 {
-    int stop = 0;
-    query_tree(bp, 0, box, NULL_NODE, NULL, fn, ctx, &stop);
-    if (!stop) query_tree(bp, 1, box, NULL_NODE, NULL, fn, ctx, &stop);
+    const bp_node *N = bp->nodes;
+    for (int tree = 0; tree < 2; tree++) {
+        walk w;
+        walk_init(&w, bp->root[tree]);
+        int stop = 0;
+        while (w.count > 0) {
+            int i = w.items[--w.count];
+            if (!aabb_overlap(N[i].box, box)) continue;
+            if (!is_leaf(&N[i])) {
+                if (!walk_push2(&w, N[i].child1, N[i].child2)) break;
+                continue;
+            }
+            if (!fn(ctx, bp->leaves[i].user)) {
+                stop = 1;
+                break;
+            }
+        }
+        walk_free(&w);
+        if (stop) return;
+    }
 }
 
-/* Entry parameter of the segment o + t d, t in [0, max_t], into box (or > max_t). */
-static double ray_box(aabb b, vec3 o, vec3 d, double max_t)
+/* The segment o + t d, t in [0, max_t], with precomputed reciprocals; an axis
+ * whose reciprocal overflows is treated as parallel (never 0 * inf = NaN). */
+typedef struct ray {
+    double o[3], inv[3];
+    int parallel[3];
+} ray;
+
+/* Entry parameter of the segment into the box, or HUGE_VAL when it misses. */
+static double ray_enter(const ray *r, aabb b, double max_t)
 {
-    double t0 = 0.0, t1 = max_t;
-    double os[3] = {o.x, o.y, o.z}, ds[3] = {d.x, d.y, d.z};
     double lo[3] = {b.lo.x, b.lo.y, b.lo.z}, hi[3] = {b.hi.x, b.hi.y, b.hi.z};
-    for (int i = 0; i < 3; i++) {
-        if (ds[i] == 0.0) {
-            if (os[i] < lo[i] || os[i] > hi[i]) return max_t + 1.0;
+    double t0 = 0.0, t1 = max_t;
+    for (int k = 0; k < 3; k++) {
+        if (r->parallel[k]) {
+            if (r->o[k] < lo[k] || r->o[k] > hi[k]) return HUGE_VAL;
             continue;
         }
-        double inv = 1.0 / ds[i];
-        double a = (lo[i] - os[i]) * inv, c = (hi[i] - os[i]) * inv;
+        double a = (lo[k] - r->o[k]) * r->inv[k], c = (hi[k] - r->o[k]) * r->inv[k];
         if (a > c) { double t = a; a = c; c = t; }
         if (a > t0) t0 = a;
         if (c < t1) t1 = c;
-        if (t0 > t1) return max_t + 1.0;
+        if (t0 > t1) return HUGE_VAL;
     }
     return t0;
 }
@@ -350,21 +503,78 @@ static double ray_box(aabb b, vec3 o, vec3 d, double max_t)
 void bp_ray_cast(const broadphase *bp, vec3 origin, vec3 dir, double max_t, bp_ray_fn *fn, void *ctx)
 {
     const bp_node *N = bp->nodes;
+    ray r;
+    double d[3] = {dir.x, dir.y, dir.z};
+    r.o[0] = origin.x;
+    r.o[1] = origin.y;
+    r.o[2] = origin.z;
+    for (int k = 0; k < 3; k++) {
+        r.inv[k] = 1.0 / d[k];
+        r.parallel[k] = !isfinite(r.inv[k]);
+    }
     for (int tree = 0; tree < 2; tree++) {
         walk w;
-        walk_init(&w);
-        if (bp->root[tree] != NULL_NODE) walk_push(&w, bp->root[tree]);
+        walk_init(&w, bp->root[tree]);
         while (w.count > 0) {
             int i = w.items[--w.count];
-            if (ray_box(N[i].box, origin, dir, max_t) > max_t) continue;
-            if (N[i].left != NULL_NODE) {
-                if (!walk_push(&w, N[i].left) || !walk_push(&w, N[i].right)) break;
+            if (ray_enter(&r, N[i].box, max_t) > max_t) continue;
+            if (!is_leaf(&N[i])) {
+                /* the nearer child on top, so a clipping callback prunes more */
+                int a = N[i].child1, b = N[i].child2;
+                if (ray_enter(&r, N[a].box, max_t) < ray_enter(&r, N[b].box, max_t)) { int t = a; a = b; b = t; }
+                if (!walk_push2(&w, a, b)) break;
                 continue;
             }
-            double t = fn(ctx, N[i].user, origin, dir, max_t);
-            if (t < 0) { walk_free(&w); return; }
+            double t = fn(ctx, bp->leaves[i].user, origin, dir, max_t);
+            if (t < 0.0) {
+                walk_free(&w);
+                return;
+            }
             if (t < max_t) max_t = t;
         }
         walk_free(&w);
     }
+}
+
+/* Every invariant: links, boxes equal to their children's union, heights,
+ * leaf and free counts, the moved buffer. */
+int bp_validate(const broadphase *bp)
+{
+    const bp_node *N = bp->nodes;
+    int leaves = 0, internal = 0, moved = 0;
+    for (int tree = 0; tree < 2; tree++) {
+        int root = bp->root[tree];
+        if (root == NULL_NODE) continue;
+        if (N[root].parent != NULL_NODE) return 0;
+        walk w;
+        walk_init(&w, root);
+        while (w.count > 0) {
+            int i = w.items[--w.count];
+            if (i < 0 || i >= bp->capacity || N[i].height < 0) { walk_free(&w); return 0; }
+            if (is_leaf(&N[i])) {
+                const bp_leaf *l = &bp->leaves[i];
+                if (N[i].height != 0 || N[i].child2 != NULL_NODE || l->tree != tree) { walk_free(&w); return 0; }
+                if (l->move_slot >= 0) {
+                    if (l->move_slot >= bp->move_count || bp->moved[l->move_slot] != i) { walk_free(&w); return 0; }
+                    moved++;
+                }
+                leaves++;
+                continue;
+            }
+            int a = N[i].child1, b = N[i].child2;
+            int ok = a >= 0 && b >= 0 && a < bp->capacity && b < bp->capacity && N[a].parent == i && N[b].parent == i &&
+                     N[i].height == 1 + max_int(N[a].height, N[b].height);
+            if (ok) {
+                aabb u = aabb_union(N[a].box, N[b].box);
+                ok = memcmp(&u, &N[i].box, sizeof u) == 0;
+            }
+            if (!ok || !walk_push2(&w, a, b)) { walk_free(&w); return 0; }
+            internal++;
+        }
+        walk_free(&w);
+    }
+    int free_nodes = 0;
+    for (int i = bp->free_list; i != NULL_NODE && free_nodes <= bp->capacity; i = N[i].parent) free_nodes++;
+    return leaves == bp->proxy_count && moved == bp->move_count && free_nodes == bp->free_count &&
+           leaves + internal + free_nodes == bp->capacity;
 }

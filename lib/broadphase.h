@@ -32,4 +32,10 @@ void bp_query(const broadphase *bp, aabb box, bp_query_fn *fn, void *ctx);
 void bp_ray_cast(const broadphase *bp, vec3 origin, vec3 dir, double max_t, bp_ray_fn *fn, void *ctx);
 int bp_proxy_count(const broadphase *bp);
 
+/* Height of the static or moving tree (-1 when empty; a single proxy is 0). */
+int bp_tree_height(const broadphase *bp, int is_static);
+/* 1 when every internal invariant holds (links, boxes, heights, counts, moved
+ * buffer); for tests. */
+int bp_validate(const broadphase *bp);
+
 #endif
