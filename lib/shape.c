@@ -1,15 +1,16 @@
 /* shape.c - mass properties, bounds, support mapping and ray casts of the
- * shapes, and convex hull construction (incremental, with coplanar triangles
+ * shapes, and convex hull construction (quickhull, then coplanar triangles
  * merged into polygon faces). */
+#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "shape.h"
 
 #define PI 3.14159265358979323846
 #define PLANE_EXTENT 1e18
 
-/* ---- mass properties --------------------------------------------------------- */
 
 double shape_volume(const shape *s)
 {
@@ -204,163 +205,447 @@ double shape_bounding_radius(const shape *s)
 }
 
 /* ---- convex hulls ------------------------------------------------------------ */
+/* Quickhull over triangles. Which faces a new point sees is decided by an
+ * exact orientation test, so the triangles always form a consistent convex
+ * surface, however nearly coplanar or duplicated the input. A tolerance
+ * relative to the cloud's size decides the rest: points within it of the
+ * hull are not added, and neighbouring triangles within it of a common plane
+ * are merged into one polygon face. Merging follows the triangle adjacency,
+ * so the polygons share their edges exactly. */
 
-typedef struct tri { int v[3]; vec3 n; double d; int alive; } tri;
+/* The tolerance, relative to the cloud's diagonal (1e-7 of a 1 m hull is 0.1
+ * micrometre). A triangle's plane measures distances with an error of about
+ * DBL_EPSILON * size^2 / height, so much below sqrt(DBL_EPSILON) most thin
+ * triangles could no longer tell points within it from points outside. */
+#define HULL_REL_TOLERANCE 1e-7
 
-static void tri_plane(tri *t, const vec3 *p)
-{
-    vec3 n = v3_cross(v3_sub(p[t->v[1]], p[t->v[0]]), v3_sub(p[t->v[2]], p[t->v[0]]));
-    t->n = v3_normalize(n);
-    t->d = v3_dot(t->n, p[t->v[0]]);
-}
+typedef struct qh_face {
+    int v[3];          /* counter-clockwise seen from outside */
+    int adj[3];        /* adj[k] lies across the edge v[k] -> v[k+1] */
+    vec3 n;            /* outward unit normal */
+    double d;          /* plane offset */
+    int outside;       /* head of this face's outside-point list, -1 when empty */
+    int far_point;     /* the outside point farthest above the face */
+    double far_dist;
+    int tested;        /* the eye stamp this face was last found hidden from */
+    int visible;
+    int alive;
+    int sliver;        /* too thin for its plane to measure distances with */
+} qh_face;
 
-typedef struct edge_rec { int a, b; } edge_rec;
+/* A horizon edge a -> b of the visible patch; the face outside it, and
+ * which of its edges this is. */
+typedef struct qh_edge { int a, b, outer, outer_edge; } qh_edge;
 
-static int edge_cmp(const void *x, const void *y)
-{
-    const edge_rec *e = x, *f = y;
-    int ea = e->a < e->b ? e->a : e->b, eb = e->a < e->b ? e->b : e->a;
-    int fa = f->a < f->b ? f->a : f->b, fb = f->a < f->b ? f->b : f->a;
-    if (ea != fa) return ea < fa ? -1 : 1;
-    return (eb > fb) - (eb < fb);
-}
+typedef struct quickhull {
+    const vec3 *p;     /* points relative to the cloud's centre */
+    int n;
+    double eps;        /* distance below which a point counts as on a plane */
+    double min_height; /* thinner triangles (height over the longest edge) are slivers */
+    qh_face *f;
+    int nf, fcap;
+    int *next_out;     /* per point: next point of the same outside list */
+    int *edge_from;    /* per point: horizon edge starting there, -1 */
+    int *vis;          /* visible faces of the current eye */
+    qh_edge *horizon, *loop;
+    int vcap, hcap, lcap;
+    int stamp;
+} quickhull;
 
 static void hull_fail(char *err, int n, const char *msg)
 {
     if (err && n > 0) snprintf(err, (size_t)n, "%s", msg);
 }
 
-/* Merges coplanar triangles into polygons, orders their vertices CCW, builds
- * edges, and computes volume, centroid and inertia. */
-static hull *hull_finish(const vec3 *p, tri *tris, int ntri, double eps)
+/* Unit normal of triangle abc (counter-clockwise), from its two shortest
+ * edges, which meet at the vertex opposite the longest: the best conditioned. */
+static vec3 tri_normal(vec3 a, vec3 b, vec3 c)
 {
-    hull *h = calloc(1, sizeof *h);
-    int *group = malloc(sizeof *group * (size_t)ntri);
-    int *vmap = malloc(sizeof *vmap * (size_t)(3 * ntri + 1));
-    int *used = NULL;
-    if (!h || !group || !vmap) goto oom;
-    int nfaces = 0;
-    for (int i = 0; i < ntri; i++) group[i] = -1;
-    for (int i = 0; i < ntri; i++) {
-        if (!tris[i].alive || group[i] >= 0) continue;
-        group[i] = nfaces;
-        for (int j = i + 1; j < ntri; j++)
-            if (tris[j].alive && group[j] < 0 && v3_dot(tris[i].n, tris[j].n) > 1.0 - 1e-9 &&
-                fabs(tris[i].d - tris[j].d) < eps)
-                group[j] = nfaces;
-        nfaces++;
+    vec3 ab = v3_sub(b, a), bc = v3_sub(c, b), ca = v3_sub(a, c);
+    double lab = v3_len2(ab), lbc = v3_len2(bc), lca = v3_len2(ca);
+    vec3 n;
+    if (lab >= lbc && lab >= lca) n = v3_cross(bc, ca);       /* longest ab: edges at c */
+    else if (lbc >= lca) n = v3_cross(ca, ab);                /* longest bc: edges at a */
+    else n = v3_cross(ab, bc);                                /* longest ca: edges at b */
+    return v3_normalize(n);
+}
+
+/* Exact orientation: the sign of ((b - a) x (c - a)) . (p - a), positive
+ * when p is above the counter-clockwise triangle abc. The hull's topology
+ * rests on these signs alone, so it is always a consistent convex surface
+ * however nearly coplanar the points are; tolerances only decide which
+ * points are worth adding and which faces are merged. */
+static void two_sum(double a, double b, double *sum, double *err)
+{
+    double s = a + b, bv = s - a, av = s - bv;
+    *sum = s;
+    *err = (a - av) + (b - bv);
+}
+
+/* Adds b to the nonoverlapping expansion e[0..n) (components in increasing
+ * magnitude, zeros dropped); returns its new length. */
+static int expansion_add(double *e, int n, double b)
+{
+    int m = 0;
+    double q = b;
+    for (int i = 0; i < n; i++) {
+        double sum, err;
+        two_sum(q, e[i], &sum, &err);
+        if (err != 0) e[m++] = err;
+        q = sum;
     }
-    /* collect distinct vertices per face */
-    int max_pts = 0;
-    for (int i = 0; i < ntri; i++)
-        for (int k = 0; k < 3; k++)
-            if (tris[i].alive && tris[i].v[k] + 1 > max_pts) max_pts = tris[i].v[k] + 1;
-    used = calloc((size_t)max_pts, sizeof *used);
-    h->faces = calloc((size_t)nfaces, sizeof *h->faces);
-    h->face_vertices = malloc(sizeof *h->face_vertices * (size_t)(3 * ntri));
-    if (!used || !h->faces || !h->face_vertices) goto oom;
-    int fv = 0;
-    for (int f = 0; f < nfaces; f++) {
-        int first = fv;
-        vec3 n = v3_zero();
-        double d = 0;
-        int cnt = 0;
-        for (int i = 0; i < ntri; i++) {
-            if (group[i] != f) continue;
-            n = v3_add(n, tris[i].n);
-            cnt++;
+    if (q != 0) e[m++] = q;
+    return m;
+}
+
+/* e += sign * u . (v x w), exactly: each product of three doubles is four
+ * doubles exactly (fma gives a product's rounding error). */
+static int expansion_add_det3(double *e, int n, vec3 u, vec3 v, vec3 w, double sign)
+{
+    const double t[6][3] = {{u.x, v.y, w.z}, {u.x, -v.z, w.y}, {u.y, v.z, w.x},
+                            {u.y, -v.x, w.z}, {u.z, v.x, w.y}, {u.z, -v.y, w.x}};
+    for (int k = 0; k < 6; k++) {
+        double xy = t[k][0] * t[k][1], xy_err = fma(t[k][0], t[k][1], -xy);
+        double hi = xy * t[k][2], lo = xy_err * t[k][2];
+        n = expansion_add(e, n, sign * hi);
+        n = expansion_add(e, n, sign * fma(xy, t[k][2], -hi));
+        n = expansion_add(e, n, sign * lo);
+        n = expansion_add(e, n, sign * fma(xy_err, t[k][2], -lo));
+    }
+    return n;
+}
+
+static int orient_sign(vec3 a, vec3 b, vec3 c, vec3 p)
+{
+    vec3 ab = v3_sub(b, a), ac = v3_sub(c, a), ap = v3_sub(p, a);
+    double m0 = ac.y * ap.z - ac.z * ap.y, m1 = ac.z * ap.x - ac.x * ap.z, m2 = ac.x * ap.y - ac.y * ap.x;
+    double det = ab.x * m0 + ab.y * m1 + ab.z * m2;
+    double permanent = fabs(ab.x) * (fabs(ac.y * ap.z) + fabs(ac.z * ap.y)) +
+                       fabs(ab.y) * (fabs(ac.z * ap.x) + fabs(ac.x * ap.z)) +
+                       fabs(ab.z) * (fabs(ac.x * ap.y) + fabs(ac.y * ap.x));
+    double bound = 8.0 * DBL_EPSILON * permanent; /* above the 7 ulp/2 bound of the float evaluation */
+    if (det > bound) return 1;
+    if (det < -bound) return -1;
+    /* exactly: ((b-a) x (c-a)).(p-a) = [b,c,p] - [a,c,p] + [a,b,p] - [a,b,c] */
+    double e[100];
+    int n = 0;
+    n = expansion_add_det3(e, n, b, c, p, 1.0);
+    n = expansion_add_det3(e, n, a, c, p, -1.0);
+    n = expansion_add_det3(e, n, a, b, p, 1.0);
+    n = expansion_add_det3(e, n, a, b, c, -1.0);
+    return n == 0 ? 0 : (e[n - 1] > 0 ? 1 : -1);
+}
+
+static int qh_sees(const quickhull *q, int face, int point)
+{
+    const qh_face *f = &q->f[face];
+    return orient_sign(q->p[f->v[0]], q->p[f->v[1]], q->p[f->v[2]], q->p[point]) > 0;
+}
+
+static void qh_plane(quickhull *q, qh_face *f)
+{
+    vec3 a = q->p[f->v[0]], b = q->p[f->v[1]], c = q->p[f->v[2]];
+    f->n = tri_normal(a, b, c);
+    f->d = (v3_dot(f->n, a) + v3_dot(f->n, b) + v3_dot(f->n, c)) / 3.0;
+    double longest = sqrt(dmax(v3_len2(v3_sub(b, a)), dmax(v3_len2(v3_sub(c, b)), v3_len2(v3_sub(a, c)))));
+    f->sliver = !(v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a))) > q->min_height * longest);
+}
+
+static double qh_dist(const quickhull *q, int face, int point)
+{
+    return v3_dot(q->f[face].n, q->p[point]) - q->f[face].d;
+}
+
+static int qh_new_face(quickhull *q, int a, int b, int c)
+{
+    if (!array_reserve((void **)&q->f, &q->fcap, q->nf + 1, sizeof *q->f)) return -1;
+    qh_face *f = &q->f[q->nf];
+    memset(f, 0, sizeof *f);
+    f->v[0] = a; f->v[1] = b; f->v[2] = c;
+    f->adj[0] = f->adj[1] = f->adj[2] = -1;
+    f->outside = f->far_point = -1;
+    f->tested = -1;
+    f->alive = 1;
+    qh_plane(q, f);
+    return q->nf++;
+}
+
+/* Puts point i in the outside list of the face it lies farthest above among
+ * faces [first_face, first_face + count) and the outer faces of the horizon
+ * edges given (within the tolerance, a point can end up above a face next to
+ * a new cone without being above the cone); drops it when it is above none
+ * (it is inside the hull). */
+static void qh_assign(quickhull *q, int i, int first_face, int count, const qh_edge *horizon, int nh)
+{
+    int best = -1;
+    double bd = q->eps;
+    for (int k = 0; k < count + nh; k++) {
+        int f = k < count ? first_face + k : horizon[k - count].outer;
+        if (q->f[f].sliver) continue; /* its neighbours see such points just as well */
+        double d = qh_dist(q, f, i);
+        if (d > bd) { bd = d; best = f; }
+    }
+    if (best < 0) return;
+    qh_face *f = &q->f[best];
+    q->next_out[i] = f->outside;
+    f->outside = i;
+    if (f->far_point < 0 || bd > f->far_dist) { f->far_point = i; f->far_dist = bd; }
+}
+
+static void qh_drop_point(quickhull *q, int face, int point)
+{
+    qh_face *f = &q->f[face];
+    int *link = &f->outside;
+    while (*link >= 0 && *link != point) link = &q->next_out[*link];
+    if (*link == point) *link = q->next_out[point];
+    f->far_point = -1;
+    for (int i = f->outside; i >= 0; i = q->next_out[i]) {
+        double d = qh_dist(q, face, i);
+        if (f->far_point < 0 || d > f->far_dist) { f->far_point = i; f->far_dist = d; }
+    }
+}
+
+/* Adds the farthest outside point of face fi: removes the faces it sees and
+ * closes the hole with a cone of triangles from the horizon to the point.
+ * Returns 0 when out of memory. */
+static int qh_add_point(quickhull *q, int fi)
+{
+    int eye = q->f[fi].far_point;
+    int stamp = ++q->stamp;
+    if (!array_reserve((void **)&q->vis, &q->vcap, q->nf, sizeof *q->vis)) return 0;
+    if (!qh_sees(q, fi, eye)) {
+        /* its distance above a nearly flat triangle was rounding */
+        qh_drop_point(q, fi, eye);
+        return 1;
+    }
+    /* the faces the eye sees form a connected patch around fi */
+    int nvis = 0;
+    q->vis[nvis++] = fi;
+    q->f[fi].visible = 1;
+    for (int i = 0; i < nvis; i++) {
+        const qh_face *g = &q->f[q->vis[i]];
+        for (int k = 0; k < 3; k++) {
+            int h = g->adj[k];
+            if (q->f[h].visible || q->f[h].tested == stamp) continue;
+            if (qh_sees(q, h, eye)) {
+                q->f[h].visible = 1;
+                q->vis[nvis++] = h;
+            } else {
+                q->f[h].tested = stamp;
+            }
+        }
+    }
+    /* horizon edges, then chained into one loop */
+    if (!array_reserve((void **)&q->horizon, &q->hcap, 3 * nvis, sizeof *q->horizon) ||
+        !array_reserve((void **)&q->loop, &q->lcap, 3 * nvis, sizeof *q->loop))
+        return 0;
+    int nh = 0;
+    for (int i = 0; i < nvis; i++) {
+        const qh_face *g = &q->f[q->vis[i]];
+        for (int k = 0; k < 3; k++) {
+            int h = g->adj[k];
+            if (q->f[h].visible) continue;
+            qh_edge e = {g->v[k], g->v[(k + 1) % 3], h, 0};
+            while (q->f[h].adj[e.outer_edge] != q->vis[i]) e.outer_edge++;
+            q->horizon[nh++] = e;
+        }
+    }
+    int simple = nh >= 3;
+    for (int i = 0; i < nh; i++) {
+        if (q->edge_from[q->horizon[i].a] >= 0) simple = 0;
+        q->edge_from[q->horizon[i].a] = i;
+    }
+    int cur = 0;
+    for (int i = 0; i < nh && simple; i++) {
+        if (cur < 0 || (i > 0 && cur == 0)) { simple = 0; break; }
+        q->loop[i] = q->horizon[cur];
+        cur = q->edge_from[q->horizon[cur].b];
+    }
+    if (cur != 0) simple = 0;
+    for (int i = 0; i < nh; i++) q->edge_from[q->horizon[i].a] = -1;
+    if (!simple) {
+        /* cannot happen with exact signs (the visible faces of a convex
+         * surface form a disc); kept so that nothing can corrupt the hull */
+        for (int i = 0; i < nvis; i++) q->f[q->vis[i]].visible = 0;
+        qh_drop_point(q, fi, eye);
+        return 1;
+    }
+    /* the cone */
+    int base = q->nf;
+    for (int i = 0; i < nh; i++)
+        if (qh_new_face(q, q->loop[i].a, q->loop[i].b, eye) < 0) return 0;
+    for (int i = 0; i < nh; i++) {
+        qh_face *f = &q->f[base + i];
+        f->adj[0] = q->loop[i].outer;
+        f->adj[1] = base + (i + 1) % nh;
+        f->adj[2] = base + (i + nh - 1) % nh;
+        q->f[q->loop[i].outer].adj[q->loop[i].outer_edge] = base + i;
+    }
+    /* the points the removed faces had outside go to the new faces */
+    for (int i = 0; i < nvis; i++) {
+        qh_face *g = &q->f[q->vis[i]];
+        int pt = g->outside;
+        g->alive = 0;
+        g->visible = 0;
+        g->outside = -1;
+        while (pt >= 0) {
+            int next = q->next_out[pt];
+            if (pt != eye) qh_assign(q, pt, base, nh, q->loop, nh);
+            pt = next;
+        }
+    }
+    return 1;
+}
+
+/* Polygon faces from the triangles: groups of coplanar neighbours, the
+ * boundary loop of each group, and vertices lying on just two faces (on an
+ * edge, not a corner) dropped. */
+typedef struct merge_state {
+    int nt;
+    int *tri;          /* alive face index per compact triangle */
+    int *compact;      /* face index -> compact triangle, -1 dead */
+    int *group;
+    int *single;       /* triangles that must stay alone (their group failed) */
+    int *order, *queue;
+    int *seed;         /* per group: the triangle whose plane it follows */
+    int ngroups;
+    int *loop_first, *loop_count, *loop_v; /* boundary loops per group */
+} merge_state;
+
+typedef struct area_index { double area; int index; } area_index;
+
+static int area_desc(const void *x, const void *y)
+{
+    const area_index *a = x, *b = y;
+    if (a->area != b->area) return a->area > b->area ? -1 : 1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+/* Groups neighbouring triangles whose corners lie within tol of the group's
+ * seed plane, and finds each group's boundary loop. Returns 1 when every
+ * group is a convex disc, 0 when some triangles had to be marked single (call
+ * again), -1 when out of memory. */
+static int merge_groups(quickhull *q, merge_state *m, double tol)
+{
+    int nt = m->nt;
+    for (int t = 0; t < nt; t++) m->group[t] = -1;
+    m->ngroups = 0;
+    for (int s = 0; s < nt; s++) {
+        int seed = m->order[s];
+        if (m->group[seed] >= 0) continue;
+        int g = m->ngroups++;
+        m->group[seed] = g;
+        m->seed[g] = seed;
+        if (m->single[seed]) continue;
+        const qh_face *sf = &q->f[m->tri[seed]];
+        int head = 0, tail = 0;
+        m->queue[tail++] = seed;
+        while (head < tail) {
+            const qh_face *f = &q->f[m->tri[m->queue[head++]]];
             for (int k = 0; k < 3; k++) {
-                int v = tris[i].v[k], seen = 0;
-                for (int q = first; q < fv; q++) if (h->face_vertices[q] == v) seen = 1;
-                if (!seen) h->face_vertices[fv++] = v;
+                int u = m->compact[f->adj[k]];
+                if (m->group[u] >= 0 || m->single[u]) continue;
+                const qh_face *uf = &q->f[m->tri[u]];
+                int flat = 1;
+                for (int j = 0; j < 3; j++)
+                    if (fabs(v3_dot(sf->n, q->p[uf->v[j]]) - sf->d) > tol) flat = 0;
+                if (!flat) continue;
+                m->group[u] = g;
+                m->queue[tail++] = u;
             }
         }
-        n = v3_normalize(n);
-        /* order CCW around the face centre, seen from outside */
-        vec3 c = v3_zero();
-        for (int q = first; q < fv; q++) c = v3_add(c, p[h->face_vertices[q]]);
-        c = v3_scale(c, 1.0 / (fv - first));
-        vec3 u, w;
-        v3_basis(n, &u, &w);
-        for (int a = first + 1; a < fv; a++) {
-            int key = h->face_vertices[a];
-            vec3 dk = v3_sub(p[key], c);
-            double ak = atan2(v3_dot(dk, w), v3_dot(dk, u));
-            int b = a - 1;
-            while (b >= first) {
-                vec3 db = v3_sub(p[h->face_vertices[b]], c);
-                if (atan2(v3_dot(db, w), v3_dot(db, u)) <= ak) break;
-                h->face_vertices[b + 1] = h->face_vertices[b];
-                b--;
+    }
+    /* boundary half-edges per group, by counting sort */
+    int ng = m->ngroups;
+    int *cnt = calloc((size_t)ng + 1, sizeof *cnt);
+    int *he = malloc(sizeof *he * (size_t)(3 * nt) * 2);
+    free(m->loop_first); free(m->loop_count); free(m->loop_v);
+    m->loop_first = malloc(sizeof *m->loop_first * (size_t)ng);
+    m->loop_count = malloc(sizeof *m->loop_count * (size_t)ng);
+    m->loop_v = malloc(sizeof *m->loop_v * (size_t)(3 * nt));
+    if (!cnt || !he || !m->loop_first || !m->loop_count || !m->loop_v) { free(cnt); free(he); return -1; }
+    for (int t = 0; t < nt; t++) {
+        const qh_face *f = &q->f[m->tri[t]];
+        for (int k = 0; k < 3; k++)
+            if (m->group[m->compact[f->adj[k]]] != m->group[t]) cnt[m->group[t] + 1]++;
+    }
+    for (int g = 0; g < ng; g++) cnt[g + 1] += cnt[g];
+    for (int g = 0; g < ng; g++) { m->loop_first[g] = cnt[g]; m->loop_count[g] = 0; }
+    for (int t = 0; t < nt; t++) {
+        const qh_face *f = &q->f[m->tri[t]];
+        int g = m->group[t];
+        for (int k = 0; k < 3; k++)
+            if (m->group[m->compact[f->adj[k]]] != g) {
+                int at = m->loop_first[g] + m->loop_count[g]++;
+                he[2 * at] = f->v[k];
+                he[2 * at + 1] = f->v[(k + 1) % 3];
             }
-            h->face_vertices[b + 1] = key;
-        }
-        for (int q = first; q < fv; q++) d += v3_dot(n, p[h->face_vertices[q]]);
-        h->faces[f].normal = n;
-        h->faces[f].offset = d / (fv - first);
-        h->faces[f].first = first;
-        h->faces[f].count = fv - first;
-        (void)cnt;
     }
-    h->face_count = nfaces;
-    /* remove collinear points on face boundaries: keep only vertices that are corners */
-    for (int f = 0; f < nfaces; f++) {
-        hull_face *F = &h->faces[f];
-        int out = F->first;
-        for (int q = 0; q < F->count; q++) {
-            int prev = h->face_vertices[F->first + (q + F->count - 1) % F->count];
-            int cur = h->face_vertices[F->first + q];
-            int next = h->face_vertices[F->first + (q + 1) % F->count];
-            vec3 cr = v3_cross(v3_sub(p[cur], p[prev]), v3_sub(p[next], p[cur]));
-            if (v3_dot(cr, F->normal) > eps * eps) h->face_vertices[out++] = cur;
+    int ok = 1;
+    for (int g = 0; g < ng; g++) {
+        int first = m->loop_first[g], count = m->loop_count[g], disc = count >= 3;
+        for (int i = first; i < first + count; i++) {
+            if (q->edge_from[he[2 * i]] >= 0) disc = 0;
+            q->edge_from[he[2 * i]] = i;
         }
-        /* compaction keeps faces in order; later faces start where they were */
-        F->count = out - F->first;
-    }
-    /* vertices: every corner of a face, renumbered */
-    for (int i = 0; i < max_pts; i++) used[i] = -1;
-    int nv = 0;
-    for (int f = 0; f < nfaces; f++)
-        for (int q = 0; q < h->faces[f].count; q++) {
-            int *v = &h->face_vertices[h->faces[f].first + q];
-            if (used[*v] < 0) used[*v] = nv++;
-            *v = used[*v];
+        int cur = first;
+        for (int i = 0; i < count && disc; i++) {
+            if (cur < 0 || (i > 0 && cur == first)) { disc = 0; break; }
+            m->loop_v[first + i] = he[2 * cur];
+            cur = q->edge_from[he[2 * cur + 1]];
         }
-    h->vertices = malloc(sizeof *h->vertices * (size_t)nv);
-    if (!h->vertices) goto oom;
-    for (int i = 0; i < max_pts; i++)
-        if (used[i] >= 0) h->vertices[used[i]] = p[i];
-    h->vertex_count = nv;
-    /* unique edges */
-    int ne_max = 0;
-    for (int f = 0; f < nfaces; f++) ne_max += h->faces[f].count;
-    h->edges = malloc(sizeof *h->edges * (size_t)(ne_max > 0 ? ne_max : 1));
-    if (!h->edges) goto oom;
-    for (int f = 0; f < nfaces; f++) {
-        const hull_face *F = &h->faces[f];
-        for (int q = 0; q < F->count; q++) {
-            int a = h->face_vertices[F->first + q], b = h->face_vertices[F->first + (q + 1) % F->count];
-            if (a < b) { h->edges[h->edge_count][0] = a; h->edges[h->edge_count][1] = b; h->edge_count++; }
+        if (cur != first) disc = 0;
+        for (int i = first; i < first + count; i++) q->edge_from[he[2 * i]] = -1;
+        if (!disc) {
+            /* not a disc (never seen): every triangle of the group stays alone */
+            ok = 0;
+            for (int t = 0; t < nt; t++) if (m->group[t] == g) m->single[t] = 1;
+            continue;
+        }
+        /* The polygon must be convex: no corner farther than the tolerance
+         * inside the line through its neighbours. A notch means a slightly
+         * tilted neighbour reaches into the plane; the group's triangles at
+         * that corner then stay alone. */
+        vec3 n = q->f[m->tri[m->seed[g]]].n;
+        for (int i = 0; i < count; i++) {
+            int corner = m->loop_v[first + i];
+            vec3 a = q->p[m->loop_v[first + (i + count - 1) % count]], b = q->p[corner];
+            vec3 c = q->p[m->loop_v[first + (i + 1) % count]];
+            if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, b)), n) >= -tol * v3_len(v3_sub(c, a))) continue;
+            ok = 0;
+            for (int t = 0; t < nt; t++) {
+                const int *v = q->f[m->tri[t]].v;
+                if (m->group[t] == g && (v[0] == corner || v[1] == corner || v[2] == corner)) m->single[t] = 1;
+            }
         }
     }
-    /* volume, centroid, inertia by tetrahedra from an interior point */
+    free(cnt);
+    free(he);
+    return ok;
+}
+
+/* Volume, centroid and inertia about the centroid (density 1) of the closed
+ * polyhedron, by tetrahedra from an interior reference point to a fan of
+ * each face. */
+static void hull_mass(hull *h)
+{
     vec3 ref = v3_zero();
-    for (int i = 0; i < nv; i++) ref = v3_add(ref, h->vertices[i]);
-    ref = v3_scale(ref, 1.0 / nv);
-    double vol = 0;
+    for (int i = 0; i < h->vertex_count; i++) ref = v3_add(ref, h->vertices[i]);
+    ref = v3_scale(ref, 1.0 / h->vertex_count);
+    double vol = 0, cov[3][3] = {{0}};
     vec3 cen = v3_zero();
-    double cov[3][3] = {{0}};
-    for (int f = 0; f < nfaces; f++) {
+    for (int f = 0; f < h->face_count; f++) {
         const hull_face *F = &h->faces[f];
         vec3 a = v3_sub(h->vertices[h->face_vertices[F->first]], ref);
-        for (int q = 1; q + 1 < F->count; q++) {
-            vec3 b = v3_sub(h->vertices[h->face_vertices[F->first + q]], ref);
-            vec3 c = v3_sub(h->vertices[h->face_vertices[F->first + q + 1]], ref);
-            double det = v3_dot(a, v3_cross(b, c));
-            vol += det / 6.0;
-            cen = v3_add(cen, v3_scale(v3_add(v3_add(a, b), c), det / 24.0));
-            /* covariance of the tetrahedron (0, a, b, c): det/120 * sum (1 + [i==j]) v_i v_j^T */
+        for (int k = 1; k + 1 < F->count; k++) {
+            vec3 b = v3_sub(h->vertices[h->face_vertices[F->first + k]], ref);
+            vec3 c = v3_sub(h->vertices[h->face_vertices[F->first + k + 1]], ref);
+            double det = v3_dot(a, v3_cross(b, c)); /* six times the signed volume */
             vec3 s = v3_add(v3_add(a, b), c);
+            vol += det / 6.0;
+            cen = v3_madd(cen, det / 24.0, s);
+            /* second moment of tetrahedron (0, a, b, c):
+             * det/120 * (s s^T + a a^T + b b^T + c c^T) */
             double S[3] = {s.x, s.y, s.z}, A[3] = {a.x, a.y, a.z}, B[3] = {b.x, b.y, b.z}, C[3] = {c.x, c.y, c.z};
             for (int i = 0; i < 3; i++)
                 for (int j = 0; j < 3; j++)
@@ -368,130 +653,286 @@ static hull *hull_finish(const vec3 *p, tri *tris, int ntri, double eps)
         }
     }
     vec3 com = v3_scale(cen, 1.0 / vol);
-    double m[3] = {com.x, com.y, com.z};
+    double c3[3] = {com.x, com.y, com.z};
+    /* second moment about the centroid, then I = tr(C) 1 - C */
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) cov[i][j] -= vol * m[i] * m[j];
+        for (int j = 0; j < 3; j++) cov[i][j] -= vol * c3[i] * c3[j];
     double tr = cov[0][0] + cov[1][1] + cov[2][2];
     h->unit_inertia = m3_cols(v3(tr - cov[0][0], -cov[1][0], -cov[2][0]), v3(-cov[0][1], tr - cov[1][1], -cov[2][1]),
                               v3(-cov[0][2], -cov[1][2], tr - cov[2][2]));
     h->volume = vol;
     h->centroid = v3_add(ref, com);
-    free(group);
-    free(vmap);
-    free(used);
+}
+
+/* Builds the hull's arrays from the merged loops; orig are the caller's
+ * points. A loop vertex is a corner of the hull when it lies on three or
+ * more faces. On just two it lies on their common edge and is left out,
+ * unless the two faces are coplanar (where a group had to be split): then it
+ * is a corner of both. */
+static hull *hull_from_loops(const quickhull *q, const merge_state *m, const vec3 *orig, double tol, char *err, int err_size)
+{
+    int ng = m->ngroups, n = q->n;
+    int *faces_at = calloc((size_t)n, sizeof *faces_at), *newidx = malloc(sizeof *newidx * (size_t)n);
+    char *corner = calloc((size_t)n, 1);
+    hull *h = calloc(1, sizeof *h);
+    if (!faces_at || !newidx || !corner || !h) goto oom;
+    for (int g = 0; g < ng; g++)
+        for (int i = 0; i < m->loop_count[g]; i++) faces_at[m->loop_v[m->loop_first[g] + i]]++;
+    for (int g = 0; g < ng; g++) {
+        const int *lv = &m->loop_v[m->loop_first[g]];
+        int count = m->loop_count[g];
+        for (int i = 0; i < count; i++) {
+            vec3 a = q->p[lv[(i + count - 1) % count]], b = q->p[lv[i]], c = q->p[lv[(i + 1) % count]];
+            if (faces_at[lv[i]] > 2 || v3_len(v3_cross(v3_sub(b, a), v3_sub(c, a))) > tol * v3_len(v3_sub(c, a)))
+                corner[lv[i]] = 1;
+        }
+    }
+    /* A face thinner than the tolerance keeps only two corners: it is left
+     * out, and its neighbours on either side meet along those two. */
+    int total = 0;
+    for (int g = 0; g < ng; g++) {
+        int kept = 0;
+        for (int i = 0; i < m->loop_count[g]; i++) kept += corner[m->loop_v[m->loop_first[g] + i]];
+        if (kept == 1) {
+            hull_fail(err, err_size, "hull points are numerically degenerate (a face with one corner)");
+            goto fail;
+        }
+        total += kept > 2 ? kept : 0;
+    }
+    h->faces = malloc(sizeof *h->faces * (size_t)ng);
+    h->face_vertices = malloc(sizeof *h->face_vertices * (size_t)total);
+    h->edges = malloc(sizeof *h->edges * (size_t)total);
+    if (!h->faces || !h->face_vertices || !h->edges) goto oom;
+    for (int i = 0; i < n; i++) newidx[i] = -1;
+    int nv = 0, fv = 0, nf = 0;
+    for (int g = 0; g < ng; g++) {
+        int kept = 0;
+        for (int i = 0; i < m->loop_count[g]; i++) kept += corner[m->loop_v[m->loop_first[g] + i]];
+        if (kept < 3) continue;
+        hull_face *F = &h->faces[nf++];
+        F->first = fv;
+        for (int i = 0; i < m->loop_count[g]; i++) {
+            int v = m->loop_v[m->loop_first[g] + i];
+            if (!corner[v]) continue;
+            if (newidx[v] < 0) newidx[v] = nv++;
+            h->face_vertices[fv++] = newidx[v];
+        }
+        F->count = fv - F->first;
+    }
+    h->face_count = nf;
+    h->vertex_count = nv;
+    h->vertices = malloc(sizeof *h->vertices * (size_t)nv);
+    if (!h->vertices) goto oom;
+    for (int i = 0; i < n; i++)
+        if (newidx[i] >= 0) h->vertices[newidx[i]] = orig[i];
+    /* planes: Newell's normal of each polygon (about its centre, where
+     * rounding is smallest), offset as the mean over its corners */
+    for (int g = 0; g < nf; g++) {
+        hull_face *F = &h->faces[g];
+        vec3 c = v3_zero(), nn = v3_zero();
+        int *idx = &h->face_vertices[F->first];
+        for (int i = 0; i < F->count; i++) c = v3_add(c, h->vertices[idx[i]]);
+        c = v3_scale(c, 1.0 / F->count);
+        for (int i = 0; i < F->count; i++) {
+            vec3 a = v3_sub(h->vertices[idx[i]], c), b = v3_sub(h->vertices[idx[(i + 1) % F->count]], c);
+            nn = v3_add(nn, v3_cross(a, b));
+        }
+        F->normal = v3_normalize(nn);
+        double d = 0;
+        for (int i = 0; i < F->count; i++) d += v3_dot(F->normal, h->vertices[idx[i]]);
+        F->offset = d / F->count;
+        for (int i = 0; i < F->count; i++) {
+            int a = idx[i], b = idx[(i + 1) % F->count];
+            if (a < b) { h->edges[h->edge_count][0] = a; h->edges[h->edge_count][1] = b; h->edge_count++; }
+        }
+    }
+    free(faces_at);
+    free(newidx);
+    free(corner);
+    hull_mass(h);
+    if (!(h->volume > 0) || !v3_is_finite(h->centroid)) {
+        hull_fail(err, err_size, "hull has no volume");
+        hull_free(h);
+        return NULL;
+    }
     return h;
 oom:
-    free(group);
-    free(vmap);
-    free(used);
+    hull_fail(err, err_size, "out of memory");
+fail:
+    free(faces_at);
+    free(newidx);
+    free(corner);
     hull_free(h);
     return NULL;
+}
+
+static void quickhull_free(quickhull *q)
+{
+    free(q->f);
+    free(q->next_out);
+    free(q->edge_from);
+    free(q->vis);
+    free(q->horizon);
+    free(q->loop);
+}
+
+static void merge_free(merge_state *m)
+{
+    free(m->tri); free(m->compact); free(m->group); free(m->single);
+    free(m->order); free(m->queue); free(m->seed);
+    free(m->loop_first); free(m->loop_count); free(m->loop_v);
+}
+
+/* The first tetrahedron: the farthest pair among the axis extremes, the
+ * point farthest from their line, the point farthest from that plane.
+ * Returns 1, 0 for degenerate points (message in err), -1 out of memory. */
+static int qh_start(quickhull *q, char *err, int err_size)
+{
+    const vec3 *p = q->p;
+    int ext[6] = {0, 0, 0, 0, 0, 0};
+    for (int i = 1; i < q->n; i++)
+        for (int a = 0; a < 3; a++) {
+            if (v3_get(p[i], a) < v3_get(p[ext[2 * a]], a)) ext[2 * a] = i;
+            if (v3_get(p[i], a) > v3_get(p[ext[2 * a + 1]], a)) ext[2 * a + 1] = i;
+        }
+    int i0 = ext[0], i1 = ext[1];
+    double best = -1;
+    for (int a = 0; a < 6; a++)
+        for (int b = a + 1; b < 6; b++) {
+            double d = v3_len2(v3_sub(p[ext[a]], p[ext[b]]));
+            if (d > best) { best = d; i0 = ext[a]; i1 = ext[b]; }
+        }
+    if (sqrt(best) <= q->eps) return hull_fail(err, err_size, "hull points are all the same point (duplicates only)"), 0;
+    vec3 axis = v3_normalize(v3_sub(p[i1], p[i0]));
+    int i2 = 0;
+    best = -1;
+    for (int i = 0; i < q->n; i++) {
+        double d = v3_len(v3_cross(axis, v3_sub(p[i], p[i0])));
+        if (d > best) { best = d; i2 = i; }
+    }
+    if (best <= q->eps) return hull_fail(err, err_size, "hull points are collinear (no area, no volume)"), 0;
+    vec3 normal = tri_normal(p[i0], p[i1], p[i2]);
+    int i3 = 0;
+    best = -1;
+    for (int i = 0; i < q->n; i++) {
+        double d = fabs(v3_dot(normal, v3_sub(p[i], p[i0])));
+        if (d > best) { best = d; i3 = i; }
+    }
+    if (best <= q->eps) return hull_fail(err, err_size, "hull points are coplanar (no volume)"), 0;
+    /* base (a, b, c) faces away from the apex d; the sides run each base edge backwards */
+    int up = orient_sign(p[i0], p[i1], p[i2], p[i3]) > 0;
+    int a = i0, b = up ? i2 : i1, c = up ? i1 : i2, d = i3;
+    int tet[4][3] = {{a, b, c}, {b, a, d}, {c, b, d}, {a, c, d}};
+    for (int f = 0; f < 4; f++)
+        if (qh_new_face(q, tet[f][0], tet[f][1], tet[f][2]) < 0) return -1;
+    for (int f = 0; f < 4; f++)
+        for (int k = 0; k < 3; k++)
+            for (int g = 0; g < 4; g++)
+                for (int j = 0; j < 3; j++)
+                    if (q->f[g].v[j] == q->f[f].v[(k + 1) % 3] && q->f[g].v[(j + 1) % 3] == q->f[f].v[k]) q->f[f].adj[k] = g;
+    for (int i = 0; i < q->n; i++)
+        if (i != a && i != b && i != c && i != d) qh_assign(q, i, 0, 4, NULL, 0);
+    return 1;
+}
+
+/* Compact triangle numbering for merging, largest first so that the seed
+ * planes are the best conditioned. Returns 0 when out of memory. */
+static int merge_init(merge_state *m, const quickhull *q)
+{
+    int nt = 0;
+    for (int f = 0; f < q->nf; f++) nt += q->f[f].alive;
+    m->nt = nt;
+    m->tri = malloc(sizeof *m->tri * (size_t)nt);
+    m->compact = malloc(sizeof *m->compact * (size_t)q->nf);
+    m->group = malloc(sizeof *m->group * (size_t)nt);
+    m->single = calloc((size_t)nt, sizeof *m->single);
+    m->order = malloc(sizeof *m->order * (size_t)nt);
+    m->queue = malloc(sizeof *m->queue * (size_t)nt);
+    m->seed = malloc(sizeof *m->seed * (size_t)nt);
+    area_index *ai = malloc(sizeof *ai * (size_t)nt);
+    if (!m->tri || !m->compact || !m->group || !m->single || !m->order || !m->queue || !m->seed || !ai) {
+        free(ai);
+        return 0;
+    }
+    nt = 0;
+    for (int f = 0; f < q->nf; f++) {
+        m->compact[f] = q->f[f].alive ? nt : -1;
+        if (!q->f[f].alive) continue;
+        const int *v = q->f[f].v;
+        ai[nt].area = v3_len(v3_cross(v3_sub(q->p[v[1]], q->p[v[0]]), v3_sub(q->p[v[2]], q->p[v[0]])));
+        ai[nt].index = nt;
+        m->tri[nt++] = f;
+    }
+    qsort(ai, (size_t)nt, sizeof *ai, area_desc);
+    for (int t = 0; t < nt; t++) m->order[t] = ai[t].index;
+    free(ai);
+    return 1;
 }
 
 hull *hull_build(const double *points, int count, char *err, int err_size)
 {
     if (!points || count < 4) { hull_fail(err, err_size, "a hull needs at least 4 points"); return NULL; }
-    vec3 *p = malloc(sizeof *p * (size_t)count);
-    if (!p) { hull_fail(err, err_size, "out of memory"); return NULL; }
+    for (size_t i = 0; i < 3 * (size_t)count; i++)
+        if (!isfinite(points[i])) { hull_fail(err, err_size, "hull points must be finite (NaN or infinity given)"); return NULL; }
+    vec3 *orig = malloc(sizeof *orig * (size_t)count), *p = malloc(sizeof *p * (size_t)count);
+    quickhull q;
+    merge_state m;
+    memset(&q, 0, sizeof q);
+    memset(&m, 0, sizeof m);
+    hull *h = NULL;
+    int started, merged;
+    if (!orig || !p) goto oom;
     vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
     for (int i = 0; i < count; i++) {
-        p[i] = v3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
-        if (!v3_is_finite(p[i])) { free(p); hull_fail(err, err_size, "hull points must be finite"); return NULL; }
-        lo = v3_min(lo, p[i]);
-        hi = v3_max(hi, p[i]);
+        orig[i] = v3(points[3 * i], points[3 * i + 1], points[3 * i + 2]);
+        lo = v3_min(lo, orig[i]);
+        hi = v3_max(hi, orig[i]);
     }
-    double scale = v3_len(v3_sub(hi, lo));
-    double eps = 1e-9 * (scale > 0 ? scale : 1.0) + 1e-12 * v3_len(v3_max(v3_abs(lo), v3_abs(hi)));
-    /* initial tetrahedron: extreme points */
-    int i0 = 0, i1 = -1, i2 = -1, i3 = -1;
-    for (int i = 1; i < count; i++) if (p[i].x < p[i0].x) i0 = i;
-    double best = 0;
-    for (int i = 0; i < count; i++) { double d = v3_len2(v3_sub(p[i], p[i0])); if (d > best) { best = d; i1 = i; } }
-    if (i1 < 0 || sqrt(best) <= eps) { free(p); hull_fail(err, err_size, "hull points are all the same point"); return NULL; }
-    best = 0;
-    vec3 dir = v3_sub(p[i1], p[i0]);
+    double size = v3_len(v3_sub(hi, lo)), far = v3_len(v3_max(v3_abs(lo), v3_abs(hi)));
+    /* keeps the exact predicate's products of three coordinates clear of
+     * overflow and underflow */
+    if (far > 1e50) { hull_fail(err, err_size, "hull points must lie within 1e50 of the origin"); goto done; }
+    if (size < 1e-50) { hull_fail(err, err_size, "hull points are all the same point (duplicates only)"); goto done; }
+    /* work relative to the centre of the bounds: far from the origin, plane
+     * offsets would otherwise lose the digits that tell points apart */
+    vec3 centre = v3_scale(v3_add(lo, hi), 0.5);
     for (int i = 0; i < count; i++) {
-        double d = v3_len(v3_cross(dir, v3_sub(p[i], p[i0]))) / v3_len(dir);
-        if (d > best) { best = d; i2 = i; }
+        p[i] = v3_sub(orig[i], centre);
+        double noise = 1e-30 * size; /* exactly zero below this */
+        if (fabs(p[i].x) < noise) p[i].x = 0;
+        if (fabs(p[i].y) < noise) p[i].y = 0;
+        if (fabs(p[i].z) < noise) p[i].z = 0;
     }
-    if (i2 < 0 || best <= eps) { free(p); hull_fail(err, err_size, "hull points are collinear"); return NULL; }
-    vec3 nrm = v3_normalize(v3_cross(dir, v3_sub(p[i2], p[i0])));
-    best = 0;
-    for (int i = 0; i < count; i++) {
-        double d = fabs(v3_dot(nrm, v3_sub(p[i], p[i0])));
-        if (d > best) { best = d; i3 = i; }
-    }
-    if (i3 < 0 || best <= eps) { free(p); hull_fail(err, err_size, "hull points are coplanar (no volume)"); return NULL; }
-    int cap = 64;
-    tri *tris = malloc(sizeof *tris * (size_t)cap);
-    edge_rec *edges = NULL;
-    int ecap = 0, ntri = 0;
-    if (!tris) { free(p); hull_fail(err, err_size, "out of memory"); return NULL; }
-    int base[4][3] = {{i0, i1, i2}, {i0, i3, i1}, {i1, i3, i2}, {i2, i3, i0}};
-    if (v3_dot(nrm, v3_sub(p[i3], p[i0])) > 0) {
-        /* make every face point away from the fourth vertex */
-        int flip[4][3] = {{i0, i2, i1}, {i0, i1, i3}, {i1, i2, i3}, {i2, i0, i3}};
-        memcpy(base, flip, sizeof base);
-    }
-    for (int f = 0; f < 4; f++) {
-        tris[ntri].v[0] = base[f][0]; tris[ntri].v[1] = base[f][1]; tris[ntri].v[2] = base[f][2];
-        tris[ntri].alive = 1;
-        tri_plane(&tris[ntri], p);
-        ntri++;
-    }
-    for (int i = 0; i < count; i++) {
-        if (i == i0 || i == i1 || i == i2 || i == i3) continue;
-        int ne = 0, any = 0;
-        for (int t = 0; t < ntri; t++) {
-            if (!tris[t].alive || v3_dot(tris[t].n, p[i]) - tris[t].d <= eps) continue;
-            any = 1;
-            if (ne + 3 > ecap) {
-                ecap = ecap ? ecap * 2 : 64;
-                edge_rec *ne_ = realloc(edges, sizeof *edges * (size_t)ecap);
-                if (!ne_) goto oom;
-                edges = ne_;
-            }
-            for (int k = 0; k < 3; k++) { edges[ne].a = tris[t].v[k]; edges[ne].b = tris[t].v[(k + 1) % 3]; ne++; }
-            tris[t].alive = 0;
-        }
-        if (!any) continue;
-        /* horizon: edges of the visible region that appear once */
-        qsort(edges, (size_t)ne, sizeof *edges, edge_cmp);
-        for (int e = 0; e < ne; e++) {
-            if ((e + 1 < ne && edge_cmp(&edges[e], &edges[e + 1]) == 0) || (e > 0 && edge_cmp(&edges[e], &edges[e - 1]) == 0))
-                continue;
-            if (ntri >= cap) {
-                cap *= 2;
-                tri *nt = realloc(tris, sizeof *tris * (size_t)cap);
-                if (!nt) goto oom;
-                tris = nt;
-            }
-            tris[ntri].v[0] = edges[e].a; tris[ntri].v[1] = edges[e].b; tris[ntri].v[2] = i;
-            tris[ntri].alive = 1;
-            tri_plane(&tris[ntri], p);
-            ntri++;
-        }
-        /* compact dead triangles now and then so the scan stays short */
-        if (ntri > 4 * count + 64) {
-            int k = 0;
-            for (int t = 0; t < ntri; t++) if (tris[t].alive) tris[k++] = tris[t];
-            ntri = k;
-        }
-    }
-    free(edges);
-    edges = NULL;
-    hull *h = hull_finish(p, tris, ntri, eps * 10);
-    free(tris);
-    free(p);
-    if (!h) { hull_fail(err, err_size, "out of memory"); return NULL; }
-    if (!(h->volume > 0)) { hull_free(h); hull_fail(err, err_size, "hull has no volume"); return NULL; }
-    return h;
+    q.p = p;
+    q.n = count;
+    q.eps = HULL_REL_TOLERANCE * size + 16.0 * DBL_EPSILON * far;
+    /* a triangle's normal is good to about DBL_EPSILON * size / height; from
+     * this height on, its distances over the cloud are good to within eps */
+    q.min_height = 8.0 * DBL_EPSILON * size * size / q.eps;
+    q.next_out = malloc(sizeof *q.next_out * (size_t)count);
+    q.edge_from = malloc(sizeof *q.edge_from * (size_t)count);
+    if (!q.next_out || !q.edge_from) goto oom;
+    for (int i = 0; i < count; i++) q.edge_from[i] = -1;
+    started = qh_start(&q, err, err_size);
+    if (started < 0) goto oom;
+    if (started == 0) goto done;
+    /* faces are appended as they are made, so one sweep reaches them all */
+    for (int fi = 0; fi < q.nf; fi++)
+        while (q.f[fi].alive && q.f[fi].outside >= 0)
+            if (!qh_add_point(&q, fi)) goto oom;
+    if (!merge_init(&m, &q)) goto oom;
+    while ((merged = merge_groups(&q, &m, 2.0 * q.eps)) == 0) {}
+    if (merged < 0) goto oom;
+    h = hull_from_loops(&q, &m, orig, 2.0 * q.eps, err, err_size);
+    goto done;
 oom:
-    free(edges);
-    free(tris);
-    free(p);
     hull_fail(err, err_size, "out of memory");
-    return NULL;
+done:
+    quickhull_free(&q);
+    merge_free(&m);
+    free(orig);
+    free(p);
+    return h;
 }
 
 hull *hull_make_box(vec3 he)
@@ -518,13 +959,13 @@ void hull_free(hull *h)
 hull *hull_clone(const hull *h)
 {
     if (!h) return NULL;
-    hull *c = malloc(sizeof *c);
+    hull *c = calloc(1, sizeof *c);
     if (!c) return NULL;
-    *c = *h;
     int nfv = 0;
-    for (int f = 0; f < h->face_count; f++) nfv = h->faces[f].first + h->faces[f].count > nfv ? h->faces[f].first + h->faces[f].count : nfv;
-    c->vertices = malloc(sizeof *c->vertices * (size_t)h->vertex_count);
-    c->faces = malloc(sizeof *c->faces * (size_t)h->face_count);
+    for (int f = 0; f < h->face_count; f++)
+        if (h->faces[f].first + h->faces[f].count > nfv) nfv = h->faces[f].first + h->faces[f].count;
+    c->vertices = malloc(sizeof *c->vertices * (size_t)(h->vertex_count > 0 ? h->vertex_count : 1));
+    c->faces = malloc(sizeof *c->faces * (size_t)(h->face_count > 0 ? h->face_count : 1));
     c->face_vertices = malloc(sizeof *c->face_vertices * (size_t)(nfv > 0 ? nfv : 1));
     c->edges = malloc(sizeof *c->edges * (size_t)(h->edge_count > 0 ? h->edge_count : 1));
     if (!c->vertices || !c->faces || !c->face_vertices || !c->edges) { hull_free(c); return NULL; }
@@ -532,148 +973,131 @@ hull *hull_clone(const hull *h)
     memcpy(c->faces, h->faces, sizeof *c->faces * (size_t)h->face_count);
     memcpy(c->face_vertices, h->face_vertices, sizeof *c->face_vertices * (size_t)nfv);
     memcpy(c->edges, h->edges, sizeof *c->edges * (size_t)h->edge_count);
+    c->vertex_count = h->vertex_count;
+    c->face_count = h->face_count;
+    c->edge_count = h->edge_count;
+    c->centroid = h->centroid;
+    c->volume = h->volume;
+    c->unit_inertia = h->unit_inertia;
     return c;
 }
-
 /* ---- ray casts --------------------------------------------------------------- */
 
-/* Smallest t >= 0 with |o + t d|^2 = r^2 (ray from outside). */
+/* Smallest t >= 0 with |o + t d| = r, for a ray starting outside the sphere. */
 static int ray_sphere(vec3 o, vec3 d, double r, double *t)
 {
     double a = v3_dot(d, d), b = v3_dot(o, d), c = v3_dot(o, o) - r * r;
-    if (c <= 0 || a <= 0) return 0; /* inside, or no direction */
+    if (c <= 0 || a <= 0 || b >= 0) return 0; /* inside, no direction, or moving away */
     double disc = b * b - a * c;
-    if (disc < 0 || b > 0) return 0;
-    *t = (-b - sqrt(disc)) / a;
+    if (disc < 0) return 0;
+    *t = c / (-b + sqrt(disc)); /* = (-b - sqrt(disc)) / a without cancellation */
     return 1;
 }
 
-/* Ray against the infinite z-axis cylinder of radius r, limited to |z| <= hh. */
+/* Ray against the side of the z-axis cylinder of radius r, |z| <= hh, from outside it. */
 static int ray_cylinder_side(vec3 o, vec3 d, double r, double hh, double *t)
 {
     double a = d.x * d.x + d.y * d.y, b = o.x * d.x + o.y * d.y, c = o.x * o.x + o.y * o.y - r * r;
-    if (a <= 0 || c <= 0) return 0;
+    if (a <= 0 || c <= 0 || b >= 0) return 0;
     double disc = b * b - a * c;
-    if (disc < 0 || b > 0) return 0;
-    double tt = (-b - sqrt(disc)) / a;
+    if (disc < 0) return 0;
+    double tt = c / (-b + sqrt(disc));
     if (fabs(o.z + tt * d.z) > hh) return 0;
     *t = tt;
     return 1;
 }
 
-/* Ray against the convex region {x: n_i . x <= d_i}: clip the parameter range. */
-static int ray_planes(vec3 o, vec3 d, const vec3 *n, const double *off, int count, double max_t, double *t, vec3 *normal)
+/* Ray against the convex region {x : n_i . x <= offset_i}, by clipping the
+ * parameter interval [0, max_t] with each plane; a ray starting inside gives
+ * no entering plane and so no hit. */
+static int ray_faces(vec3 o, vec3 d, const hull_face *faces, int count, double max_t, double *t, vec3 *normal)
 {
     double enter = 0.0, leave = max_t;
     int face = -1;
     for (int i = 0; i < count; i++) {
-        double num = off[i] - v3_dot(n[i], o), den = v3_dot(n[i], d);
+        double num = faces[i].offset - v3_dot(faces[i].normal, o), den = v3_dot(faces[i].normal, d);
         if (den == 0) {
-            if (num < 0) return 0;
+            if (num < 0) return 0; /* parallel and outside */
             continue;
         }
         double s = num / den;
-        if (den < 0) { if (s > enter) { enter = s; face = i; } }
-        else if (s < leave) leave = s;
+        if (den < 0) {
+            if (s > enter) { enter = s; face = i; }
+        } else if (s < leave) {
+            leave = s;
+        }
         if (enter > leave) return 0;
     }
-    if (face < 0) return 0; /* started inside */
+    if (face < 0) return 0;
     *t = enter;
-    *normal = n[face];
+    *normal = faces[face].normal;
     return 1;
 }
 
 int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t, vec3 *normal)
 {
-    double tt = 0;
+    double tt = INFINITY, c;
     vec3 n = v3_zero();
-    int hit = 0;
     switch (s->type) {
     case SHAPE_SPHERE:
-        hit = ray_sphere(o, d, s->radius, &tt);
-        if (hit) n = v3_normalize(v3_madd(o, tt, d));
+        if (ray_sphere(o, d, s->radius, &tt)) n = v3_normalize(v3_madd(o, tt, d));
         break;
     case SHAPE_BOX: {
         vec3 h = s->half_extents;
-        vec3 ns[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-        double off[6] = {h.x, h.x, h.y, h.y, h.z, h.z};
-        hit = ray_planes(o, d, ns, off, 6, max_t, &tt, &n);
+        hull_face box[6] = {{{1, 0, 0}, h.x, 0, 0}, {{-1, 0, 0}, h.x, 0, 0}, {{0, 1, 0}, h.y, 0, 0},
+                            {{0, -1, 0}, h.y, 0, 0}, {{0, 0, 1}, h.z, 0, 0}, {{0, 0, -1}, h.z, 0, 0}};
+        if (!ray_faces(o, d, box, 6, max_t, &tt, &n)) return 0;
         break;
     }
     case SHAPE_CAPSULE: {
-        double best = INFINITY, c;
-        vec3 top = v3(0, 0, s->half_height), bot = v3(0, 0, -s->half_height);
-        /* inside the capsule: no hit */
-        double z = fmax(-s->half_height, fmin(s->half_height, o.z));
-        if (v3_len2(v3_sub(o, v3(0, 0, z))) <= s->radius * s->radius) return 0;
-        if (ray_cylinder_side(o, d, s->radius, s->half_height, &c) && c < best) {
-            best = c;
+        double hh = s->half_height, r = s->radius;
+        double z = dmax(-hh, dmin(hh, o.z));
+        if (v3_len2(v3_sub(o, v3(0, 0, z))) <= r * r) return 0; /* starts inside */
+        if (ray_cylinder_side(o, d, r, hh, &c)) {
+            tt = c;
             vec3 p = v3_madd(o, c, d);
             n = v3_normalize(v3(p.x, p.y, 0));
         }
-        if (ray_sphere(v3_sub(o, top), d, s->radius, &c) && c < best) { best = c; n = v3_normalize(v3_sub(v3_madd(o, c, d), top)); }
-        if (ray_sphere(v3_sub(o, bot), d, s->radius, &c) && c < best) { best = c; n = v3_normalize(v3_sub(v3_madd(o, c, d), bot)); }
-        hit = best < INFINITY;
-        tt = best;
+        for (int end = -1; end <= 1; end += 2) {
+            vec3 centre = v3(0, 0, end * hh);
+            if (ray_sphere(v3_sub(o, centre), d, r, &c) && c < tt) {
+                tt = c;
+                n = v3_normalize(v3_sub(v3_madd(o, c, d), centre));
+            }
+        }
         break;
     }
     case SHAPE_CYLINDER: {
-        double best = INFINITY, c;
-        if (fabs(o.z) <= s->half_height && o.x * o.x + o.y * o.y <= s->radius * s->radius) return 0;
-        if (ray_cylinder_side(o, d, s->radius, s->half_height, &c) && c < best) {
-            best = c;
+        double hh = s->half_height, r = s->radius;
+        if (fabs(o.z) <= hh && o.x * o.x + o.y * o.y <= r * r) return 0; /* starts inside */
+        if (ray_cylinder_side(o, d, r, hh, &c)) {
+            tt = c;
             vec3 p = v3_madd(o, c, d);
             n = v3_normalize(v3(p.x, p.y, 0));
         }
-        for (int side = -1; side <= 1; side += 2) {
-            double hz = side * s->half_height;
-            if (d.z == 0 || (o.z - hz) * side <= 0) continue;
-            c = (hz - o.z) / d.z;
+        for (int end = -1; end <= 1; end += 2) {
+            /* a cap is entered only from its outer side, moving inwards */
+            if ((o.z - end * hh) * end <= 0 || d.z * end >= 0) continue;
+            c = (end * hh - o.z) / d.z;
             vec3 p = v3_madd(o, c, d);
-            if (c >= 0 && p.x * p.x + p.y * p.y <= s->radius * s->radius && c < best) { best = c; n = v3(0, 0, side); }
-        }
-        hit = best < INFINITY;
-        tt = best;
-        break;
-    }
-    case SHAPE_HULL: {
-        const hull *h = s->hull;
-        vec3 ns[256];
-        double off[256];
-        /* the face planes, in batches to bound stack use */
-        if (h->face_count <= 256) {
-            for (int i = 0; i < h->face_count; i++) { ns[i] = h->faces[i].normal; off[i] = h->faces[i].offset; }
-            hit = ray_planes(o, d, ns, off, h->face_count, max_t, &tt, &n);
-        } else {
-            double enter = 0, leave = max_t;
-            int face = -1;
-            for (int i = 0; i < h->face_count; i++) {
-                double num = h->faces[i].offset - v3_dot(h->faces[i].normal, o), den = v3_dot(h->faces[i].normal, d);
-                if (den == 0) { if (num < 0) return 0; continue; }
-                double sv = num / den;
-                if (den < 0) { if (sv > enter) { enter = sv; face = i; } }
-                else if (sv < leave) leave = sv;
-                if (enter > leave) return 0;
-            }
-            if (face < 0) return 0;
-            hit = 1;
-            tt = enter;
-            n = h->faces[face].normal;
+            if (p.x * p.x + p.y * p.y <= r * r && c < tt) { tt = c; n = v3(0, 0, end); }
         }
         break;
     }
+    case SHAPE_HULL:
+        if (!ray_faces(o, d, s->hull->faces, s->hull->face_count, max_t, &tt, &n)) return 0;
+        break;
     case SHAPE_PLANE: {
         double num = s->plane_offset - v3_dot(s->plane_normal, o), den = v3_dot(s->plane_normal, d);
-        if (num >= 0 || den >= 0) return 0; /* starts inside the solid, or moves away */
+        if (num >= 0 || den >= 0) return 0; /* starts in the solid, or moves away from it */
         tt = num / den;
         n = s->plane_normal;
-        hit = 1;
         break;
     }
     default:
         return 0;
     }
-    if (!hit || tt < 0 || tt > max_t) return 0;
+    if (!(tt >= 0 && tt <= max_t)) return 0;
     *t = tt;
     *normal = n;
     return 1;
