@@ -1,6 +1,6 @@
 /* shape.c - mass properties, bounds, support mapping and ray casts of the
- * shapes, and convex hull construction (quickhull, then coplanar triangles
- * merged into polygon faces). */
+ * shapes, and convex hull construction (quickhull with exact orientation
+ * tests, then coplanar triangles merged into convex polygon faces). */
 #include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,6 +11,7 @@
 #define PI 3.14159265358979323846
 #define PLANE_EXTENT 1e18
 
+/* ---- mass properties --------------------------------------------------------- */
 
 double shape_volume(const shape *s)
 {
@@ -112,7 +113,7 @@ aabb shape_aabb(const shape *s, xform t)
         double ex[3];
         for (int i = 0; i < 3; i++) {
             double ai = v3_get(a, i);
-            ex[i] = s->half_height * fabs(ai) + s->radius * sqrt(fmax(0.0, 1.0 - ai * ai));
+            ex[i] = s->half_height * fabs(ai) + s->radius * sqrt(dmax(0.0, 1.0 - ai * ai));
         }
         vec3 e = v3(ex[0], ex[1], ex[2]);
         b.lo = v3_sub(t.p, e);
@@ -197,7 +198,7 @@ double shape_bounding_radius(const shape *s)
     case SHAPE_CYLINDER: return sqrt(s->half_height * s->half_height + s->radius * s->radius);
     case SHAPE_HULL: {
         double m = 0;
-        for (int i = 0; i < s->hull->vertex_count; i++) m = fmax(m, v3_len(s->hull->vertices[i]));
+        for (int i = 0; i < s->hull->vertex_count; i++) m = dmax(m, v3_len(s->hull->vertices[i]));
         return m;
     }
     default: return PLANE_EXTENT;
@@ -248,7 +249,10 @@ typedef struct quickhull {
     int *edge_from;    /* per point: horizon edge starting there, -1 */
     int *vis;          /* visible faces of the current eye */
     qh_edge *horizon, *loop;
-    int vcap, hcap, lcap;
+    int *cone;         /* the faces made for the current eye */
+    int *dead;         /* slots of removed faces, reused for new ones */
+    int *pending;      /* queue of faces that may still have outside points */
+    int vcap, hcap, lcap, ccap, dcap, pcap, ndead, npending, next_pending;
     int stamp;
 } quickhull;
 
@@ -358,8 +362,14 @@ static double qh_dist(const quickhull *q, int face, int point)
 
 static int qh_new_face(quickhull *q, int a, int b, int c)
 {
-    if (!array_reserve((void **)&q->f, &q->fcap, q->nf + 1, sizeof *q->f)) return -1;
-    qh_face *f = &q->f[q->nf];
+    int slot;
+    if (q->ndead > 0) {
+        slot = q->dead[--q->ndead];
+    } else {
+        if (!array_reserve((void **)&q->f, &q->fcap, q->nf + 1, sizeof *q->f)) return -1;
+        slot = q->nf++;
+    }
+    qh_face *f = &q->f[slot];
     memset(f, 0, sizeof *f);
     f->v[0] = a; f->v[1] = b; f->v[2] = c;
     f->adj[0] = f->adj[1] = f->adj[2] = -1;
@@ -367,29 +377,34 @@ static int qh_new_face(quickhull *q, int a, int b, int c)
     f->tested = -1;
     f->alive = 1;
     qh_plane(q, f);
-    return q->nf++;
+    return slot;
 }
 
 /* Puts point i in the outside list of the face it lies farthest above among
- * faces [first_face, first_face + count) and the outer faces of the horizon
- * edges given (within the tolerance, a point can end up above a face next to
- * a new cone without being above the cone); drops it when it is above none
- * (it is inside the hull). */
-static void qh_assign(quickhull *q, int i, int first_face, int count, const qh_edge *horizon, int nh)
+ * faces[0..count) and the outer faces of the horizon edges given (within the
+ * tolerance, a point can end up above a face next to a new cone without
+ * being above the cone); drops it when it is above none (it is inside the
+ * hull). Returns 0 when out of memory. */
+static int qh_assign(quickhull *q, int i, const int *faces, int count, const qh_edge *horizon, int nh)
 {
     int best = -1;
     double bd = q->eps;
     for (int k = 0; k < count + nh; k++) {
-        int f = k < count ? first_face + k : horizon[k - count].outer;
+        int f = k < count ? faces[k] : horizon[k - count].outer;
         if (q->f[f].sliver) continue; /* its neighbours see such points just as well */
         double d = qh_dist(q, f, i);
         if (d > bd) { bd = d; best = f; }
     }
-    if (best < 0) return;
+    if (best < 0) return 1;
     qh_face *f = &q->f[best];
+    if (f->outside < 0) {
+        if (!array_reserve((void **)&q->pending, &q->pcap, q->npending + 1, sizeof *q->pending)) return 0;
+        q->pending[q->npending++] = best;
+    }
     q->next_out[i] = f->outside;
     f->outside = i;
     if (f->far_point < 0 || bd > f->far_dist) { f->far_point = i; f->far_dist = bd; }
+    return 1;
 }
 
 static void qh_drop_point(quickhull *q, int face, int point)
@@ -470,16 +485,19 @@ static int qh_add_point(quickhull *q, int fi)
         qh_drop_point(q, fi, eye);
         return 1;
     }
-    /* the cone */
-    int base = q->nf;
+    /* the cone (in slots of faces removed before: the visible ones still
+     * hold their outside points) */
+    if (!array_reserve((void **)&q->cone, &q->ccap, nh, sizeof *q->cone) ||
+        !array_reserve((void **)&q->dead, &q->dcap, q->ndead + nvis, sizeof *q->dead))
+        return 0;
     for (int i = 0; i < nh; i++)
-        if (qh_new_face(q, q->loop[i].a, q->loop[i].b, eye) < 0) return 0;
+        if ((q->cone[i] = qh_new_face(q, q->loop[i].a, q->loop[i].b, eye)) < 0) return 0;
     for (int i = 0; i < nh; i++) {
-        qh_face *f = &q->f[base + i];
+        qh_face *f = &q->f[q->cone[i]];
         f->adj[0] = q->loop[i].outer;
-        f->adj[1] = base + (i + 1) % nh;
-        f->adj[2] = base + (i + nh - 1) % nh;
-        q->f[q->loop[i].outer].adj[q->loop[i].outer_edge] = base + i;
+        f->adj[1] = q->cone[(i + 1) % nh];
+        f->adj[2] = q->cone[(i + nh - 1) % nh];
+        q->f[q->loop[i].outer].adj[q->loop[i].outer_edge] = q->cone[i];
     }
     /* the points the removed faces had outside go to the new faces */
     for (int i = 0; i < nvis; i++) {
@@ -488,9 +506,10 @@ static int qh_add_point(quickhull *q, int fi)
         g->alive = 0;
         g->visible = 0;
         g->outside = -1;
+        q->dead[q->ndead++] = q->vis[i];
         while (pt >= 0) {
             int next = q->next_out[pt];
-            if (pt != eye) qh_assign(q, pt, base, nh, q->loop, nh);
+            if (pt != eye && !qh_assign(q, pt, q->cone, nh, q->loop, nh)) return 0;
             pt = next;
         }
     }
@@ -774,6 +793,9 @@ static void quickhull_free(quickhull *q)
     free(q->vis);
     free(q->horizon);
     free(q->loop);
+    free(q->cone);
+    free(q->dead);
+    free(q->pending);
 }
 
 static void merge_free(merge_state *m)
@@ -830,8 +852,9 @@ static int qh_start(quickhull *q, char *err, int err_size)
             for (int g = 0; g < 4; g++)
                 for (int j = 0; j < 3; j++)
                     if (q->f[g].v[j] == q->f[f].v[(k + 1) % 3] && q->f[g].v[(j + 1) % 3] == q->f[f].v[k]) q->f[f].adj[k] = g;
+    const int first4[4] = {0, 1, 2, 3};
     for (int i = 0; i < q->n; i++)
-        if (i != a && i != b && i != c && i != d) qh_assign(q, i, 0, 4, NULL, 0);
+        if (i != a && i != b && i != c && i != d && !qh_assign(q, i, first4, 4, NULL, 0)) return -1;
     return 1;
 }
 
@@ -916,10 +939,13 @@ hull *hull_build(const double *points, int count, char *err, int err_size)
     started = qh_start(&q, err, err_size);
     if (started < 0) goto oom;
     if (started == 0) goto done;
-    /* faces are appended as they are made, so one sweep reaches them all */
-    for (int fi = 0; fi < q.nf; fi++)
+    /* first come, first served: the hull grows evenly (much faster than
+     * depth first on large clouds) */
+    while (q.next_pending < q.npending) {
+        int fi = q.pending[q.next_pending++];
         while (q.f[fi].alive && q.f[fi].outside >= 0)
             if (!qh_add_point(&q, fi)) goto oom;
+    }
     if (!merge_init(&m, &q)) goto oom;
     while ((merged = merge_groups(&q, &m, 2.0 * q.eps)) == 0) {}
     if (merged < 0) goto oom;
