@@ -327,7 +327,8 @@ static int orient_sign(vec3 a, vec3 b, vec3 c, vec3 p)
     double permanent = fabs(ab.x) * (fabs(ac.y * ap.z) + fabs(ac.z * ap.y)) +
                        fabs(ab.y) * (fabs(ac.z * ap.x) + fabs(ac.x * ap.z)) +
                        fabs(ab.z) * (fabs(ac.x * ap.y) + fabs(ac.y * ap.x));
-    double bound = 8.0 * DBL_EPSILON * permanent; /* above the 7 ulp/2 bound of the float evaluation */
+    /* the rounding error of the line above is below 7 * 2^-53 * permanent (Shewchuk) */
+    double bound = 8.0 * DBL_EPSILON * permanent;
     if (det > bound) return 1;
     if (det < -bound) return -1;
     /* exactly: ((b-a) x (c-a)).(p-a) = [b,c,p] - [a,c,p] + [a,b,p] - [a,b,c] */
@@ -407,6 +408,7 @@ static int qh_assign(quickhull *q, int i, const int *faces, int count, const qh_
     return 1;
 }
 
+/* Takes point out of face's outside list and finds the list's new farthest. */
 static void qh_drop_point(quickhull *q, int face, int point)
 {
     qh_face *f = &q->f[face];
