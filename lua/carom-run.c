@@ -1,11 +1,26 @@
 /* carom-run - plays a Lua scene headless at a fixed step.
+ *
  *   carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]
  *                       [--bench] [--record FILE.csv] [--quiet]
- *   carom-run --test script.lua      (runs a test script; exit status 1 if it fails)
- * A scene module returns { world = {options}, steps = N, load = function(world),
- * update = function(world, dt), contact = function(event), report = function(world) }.
- * The loop itself is the Lua chunk below, so scenes and the runner share one
- * language; the module "carom" is linked in. */
+ *   carom-run --test script.lua
+ *
+ * A scene is a Lua file returning a table:
+ *   { world = {options for carom.world}, steps = N, dt = DT,
+ *     load = function(world) end, update = function(world, dt) end,
+ *     contact = function(event) end, report = function(world) end }
+ * (every field optional). The runner makes the world, calls load, then for
+ * each step update and world:step(dt) (contact is the world's contact
+ * callback), then report. --record writes every body's pose after each step
+ * as CSV; --bench prints the median time per step and the accuracy probes.
+ * --test runs a script plainly (it prints "N passed, M failed" and fails by
+ * raising an error or calling os.exit(1)).
+ *
+ * Exit status: 0 success, 1 the scene or script failed, 2 bad command line.
+ * The module "carom" is linked in (package.preload), so no carom.so is needed
+ * and the runner runs under the sanitizers. Scripts see the usual global
+ * `arg` (arg[0] the script, arg[-1] this program). */
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,138 +30,230 @@
 
 int luaopen_carom(lua_State *L);
 
+/* The fixed-step loop, in Lua so that scenes and runner share one language.
+ * Receives the options table built from the command line. */
 static const char driver[] =
     "local carom = require 'carom'\n"
     "local opts = ...\n"
-    "local ok_load, scene = pcall(dofile, opts.scene)\n"
-    "if not ok_load then error(scene, 0) end\n"
-    "if type(scene) ~= 'table' then error(opts.scene .. ': a scene must return a table', 0) end\n"
+    "local chunk, err = loadfile(opts.scene)\n"
+    "if not chunk then error(err, 0) end\n"
+    "local scene = chunk()\n"
+    "if type(scene) ~= 'table' then\n"
+    "  error(opts.scene .. ': a scene must return a table {load = ..., update = ..., report = ...}, got ' .. type(scene), 0)\n"
+    "end\n"
+    "for _, k in ipairs{'load', 'update', 'contact', 'report'} do\n"
+    "  if scene[k] ~= nil and type(scene[k]) ~= 'function' then\n"
+    "    error(opts.scene .. ': scene.' .. k .. ' must be a function, got ' .. type(scene[k]), 0)\n"
+    "  end\n"
+    "end\n"
+    "if scene.world ~= nil and type(scene.world) ~= 'table' then error(opts.scene .. ': scene.world must be a table of world options', 0) end\n"
+    "local function positive_number(v, what, integer)\n"
+    "  if v == nil then return nil end\n"
+    "  if type(v) ~= 'number' or v ~= v or v <= 0 or v == math.huge or (integer and v % 1 ~= 0) then\n"
+    "    error(opts.scene .. ': scene.' .. what .. ' must be a positive ' .. (integer and 'integer' or 'number'), 0)\n"
+    "  end\n"
+    "  return v\n"
+    "end\n"
     "local wopts = {}\n"
     "for k, v in pairs(scene.world or {}) do wopts[k] = v end\n"
     "if opts.substeps then wopts.substeps = opts.substeps end\n"
     "local world = carom.world(wopts)\n"
-    "local dt = opts.dt or scene.dt or 1/60\n"
-    "local steps = opts.steps or (opts.seconds and math.floor(opts.seconds / dt + 0.5)) or scene.steps or 600\n"
+    "local dt = opts.dt or positive_number(scene.dt, 'dt') or 1/60\n"
+    "if dt > 1 then error(opts.scene .. ': scene.dt must be at most 1 s', 0) end\n"
+    "local steps = opts.steps or (opts.seconds and math.max(1, math.floor(opts.seconds / dt + 0.5)))\n"
+    "  or positive_number(scene.steps, 'steps', true) or 600\n"
+    "steps = math.tointeger(steps)\n"
     "if scene.contact then world:set_contact_callback(scene.contact) end\n"
     "if scene.load then scene.load(world) end\n"
     "local rec\n"
     "if opts.record then\n"
-    "  rec = assert(io.open(opts.record, 'w'))\n"
+    "  local f, why = io.open(opts.record, 'w')\n"
+    "  if not f then error('cannot write the record file: ' .. why, 0) end\n"
+    "  rec = f\n"
     "  rec:write('step,t,body,x,y,z,qw,qx,qy,qz\\n')\n"
     "end\n"
+    "local fmt = '%d,%.9g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\\n'\n"
     "local function record(s)\n"
-    "  local bodies = world:bodies()\n"
-    "  table.sort(bodies, function(a, b) return a:id() < b:id() end)\n"
-    "  for _, b in ipairs(bodies) do\n"
+    "  for _, b in ipairs(world:bodies()) do\n"
     "    local x, y, z = b:position()\n"
     "    local qw, qx, qy, qz = b:orientation()\n"
-    "    rec:write(string.format('%d,%.6f,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\\n', s, s * dt, b:id(), x, y, z, qw, qx, qy, qz))\n"
+    "    rec:write(string.format(fmt, s, s * dt, b:id(), x, y, z, qw, qx, qy, qz))\n"
     "  end\n"
     "end\n"
     "if rec then record(0) end\n"
-    "local times, window, wstart = {}, math.max(1, steps // 20), carom.clock()\n"
-    "local last_print, t0 = carom.clock(), carom.clock()\n"
+    "local clock = carom.clock\n"
+    "local window = math.max(1, steps // 50)\n"
+    "local windows, wstart = {}, clock()\n"
+    "local t0 = clock()\n"
+    "local last_print = t0\n"
+    "local update = scene.update\n"
     "for s = 1, steps do\n"
-    "  if scene.update then scene.update(world, dt) end\n"
+    "  if update then update(world, dt) end\n"
     "  world:step(dt)\n"
     "  if rec then record(s) end\n"
-    "  if s % window == 0 then local now = carom.clock(); times[#times + 1] = (now - wstart) * 1000 / window; wstart = now end\n"
-    "  if not opts.quiet and carom.clock() - last_print > 2 then\n"
-    "    last_print = carom.clock()\n"
-    "    io.write(string.format('  step %d/%d (%.0f%%)\\n', s, steps, 100 * s / steps)); io.flush()\n"
+    "  if s % window == 0 then\n"
+    "    local now = clock()\n"
+    "    windows[#windows + 1] = (now - wstart) * 1000 / window\n"
+    "    wstart = now\n"
+    "  end\n"
+    "  if not opts.quiet and s < steps and clock() - last_print >= 2 then\n"
+    "    last_print = clock()\n"
+    "    io.stderr:write(string.format('carom-run: step %d of %d (%.0f%%), %.3f ms/step\\n', s, steps, 100 * s / steps,\n"
+    "      (last_print - t0) * 1000 / s))\n"
     "  end\n"
     "end\n"
-    "local wall = carom.clock() - t0\n"
+    "local wall = clock() - t0\n"
     "if rec then rec:close() end\n"
     "if scene.report then scene.report(world) end\n"
     "if opts.bench then\n"
-    "  table.sort(times)\n"
-    "  local med = #times > 0 and times[(#times + 1) // 2] or wall * 1000 / math.max(steps, 1)\n"
+    "  table.sort(windows)\n"
+    "  local median = #windows > 0 and windows[(#windows + 1) // 2] or wall * 1000 / steps\n"
     "  local st = world:stats()\n"
     "  local ke, pe = world:energy()\n"
-    "  local px, py, pz = world:momentum()\n"
-    "  print(string.format('bench: %d steps of %.5f s, %.4f ms/step (median of %d windows), %.3f s wall', steps, dt, med, #times, wall))\n"
-    "  print(string.format('probes: bodies %d awake %d contacts %d points %d max_penetration %.5f m KE %.6g J PE %.6g J momentum (%.4g, %.4g, %.4g)',\n"
-    "    st.bodies, st.awake_bodies, st.contacts, st.contact_points, st.max_penetration, ke, pe, px, py, pz))\n"
+    "  local px, py, pz, lx, ly, lz = world:momentum()\n"
+    "  print(string.format('bench: %d steps of %.6g s: %.4f ms/step (median of %d windows of %d steps), %.3f s in all',\n"
+    "    steps, dt, median, #windows, window, wall))\n"
+    "  print(string.format('bench: stages (last step, ms): broadphase %.4f narrowphase %.4f solver %.4f continuous %.4f islands %.4f',\n"
+    "    st.ms_broadphase, st.ms_narrowphase, st.ms_solver, st.ms_continuous, st.ms_islands))\n"
+    "  print(string.format('probes: bodies %d (awake %d), contacts %d (%d points), max penetration %.6f m (now %.6f m)',\n"
+    "    st.bodies, st.awake_bodies, st.contacts, st.contact_points, st.max_penetration, world:measure_penetration()))\n"
+    "  print(string.format('probes: kinetic energy %.9g J, potential energy %.9g J, total %.9g J', ke, pe, ke + pe))\n"
+    "  print(string.format('probes: momentum (%.6g, %.6g, %.6g) kg m/s, angular momentum (%.6g, %.6g, %.6g) kg m^2/s',\n"
+    "    px, py, pz, lx, ly, lz))\n"
     "end\n";
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K] [--bench] [--record FILE.csv] [--quiet]\n"
-               "       carom-run --test script.lua\n");
+    fprintf(f, "usage: carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]\n"
+               "                           [--bench] [--record FILE.csv] [--quiet]\n"
+               "       carom-run --test script.lua\n"
+               "  --steps N      run N steps (default: the scene's `steps`, else 600)\n"
+               "  --seconds S    run S seconds of simulated time\n"
+               "  --dt DT        the fixed step in seconds, 0 < DT <= 1 (default: the scene's `dt`, else 1/60)\n"
+               "  --substeps K   sub-steps per step, 1..64 (overrides the scene's world options)\n"
+               "  --bench        print the median ms/step and the accuracy probes at the end\n"
+               "  --record FILE  write every body's pose after every step as CSV\n"
+               "                 (step,t,body,x,y,z,qw,qx,qy,qz)\n"
+               "  --quiet        no progress lines\n"
+               "  --test FILE    run a test script (exit status 1 if it fails)\n"
+               "exit status: 0 success, 1 the scene or script failed, 2 bad command line\n");
 }
 
-static int report(lua_State *L, int status)
+static int bad_usage(const char *fmt, ...)
 {
-    if (status != LUA_OK) {
-        const char *msg = lua_tostring(L, -1);
-        fprintf(stderr, "carom-run: %s\n", msg ? msg : "(error object is not a string)");
-    }
-    return status;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "carom-run: ");
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "\n(carom-run --help for usage)\n");
+    va_end(ap);
+    return 2;
 }
 
-static int traceback(lua_State *L)
+static int message_handler(lua_State *L)
 {
     const char *msg = lua_tostring(L, 1);
-    luaL_traceback(L, L, msg ? msg : "(error object is not a string)", 1);
+    if (!msg) {
+        if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) msg = lua_tostring(L, -1);
+        else msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+    }
+    luaL_traceback(L, L, msg, 1);
     return 1;
 }
 
+/* A whole-string number; 0 if s is not one. */
 static int parse_number(const char *s, double *out)
 {
     char *end;
     double v = strtod(s, &end);
-    if (end == s || *end != '\0') return 0;
+    if (end == s || *end != '\0' || !isfinite(v)) return 0;
     *out = v;
     return 1;
+}
+
+/* Sets the global `arg` as the standalone interpreter does. */
+static void set_arg(lua_State *L, const char *program, const char *script)
+{
+    lua_createtable(L, 1, 1);
+    lua_pushstring(L, program);
+    lua_rawseti(L, -2, -1);
+    lua_pushstring(L, script);
+    lua_rawseti(L, -2, 0);
+    lua_setglobal(L, "arg");
 }
 
 int main(int argc, char **argv)
 {
     const char *scene = NULL, *record = NULL, *test = NULL;
     double steps = -1, seconds = -1, dt = -1, substeps = -1;
-    int bench = 0, quiet = 0;
+    int bench = 0, quiet = 0, scene_options = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         double *target = NULL;
-        if (!strcmp(a, "--steps")) target = &steps;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            return 0;
+        } else if (!strcmp(a, "--steps")) target = &steps;
         else if (!strcmp(a, "--seconds")) target = &seconds;
         else if (!strcmp(a, "--dt")) target = &dt;
         else if (!strcmp(a, "--substeps")) target = &substeps;
-        else if (!strcmp(a, "--bench")) { bench = 1; continue; }
-        else if (!strcmp(a, "--quiet")) { quiet = 1; continue; }
-        else if (!strcmp(a, "--record") || !strcmp(a, "--test")) {
-            if (i + 1 >= argc) { fprintf(stderr, "carom-run: %s needs a file\n", a); return 2; }
-            if (!strcmp(a, "--record")) record = argv[++i];
-            else test = argv[++i];
+        else if (!strcmp(a, "--bench")) {
+            bench = scene_options = 1;
             continue;
-        } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
-        else if (a[0] == '-') { fprintf(stderr, "carom-run: unknown option %s\n", a); usage(stderr); return 2; }
-        else if (!scene) { scene = a; continue; }
-        else { fprintf(stderr, "carom-run: more than one scene given\n"); return 2; }
-        if (i + 1 >= argc || !parse_number(argv[i + 1], target)) {
-            fprintf(stderr, "carom-run: %s needs a number\n", a);
-            return 2;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
+            continue;
+        } else if (!strcmp(a, "--record") || !strcmp(a, "--test")) {
+            if (i + 1 >= argc || argv[i + 1][0] == '\0') return bad_usage("%s needs a file name", a);
+            if (!strcmp(a, "--record")) {
+                if (record) return bad_usage("%s given twice", a);
+                record = argv[++i];
+                scene_options = 1;
+            } else {
+                if (test) return bad_usage("%s given twice", a);
+                test = argv[++i];
+            }
+            continue;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return bad_usage("unknown option %s", a);
+        } else if (!scene) {
+            scene = a;
+            continue;
+        } else {
+            return bad_usage("one scene at a time (got a second: %s)", a);
         }
+        if (*target >= 0) return bad_usage("%s given twice", a);
+        if (i + 1 >= argc) return bad_usage("%s needs a number", a);
+        if (!parse_number(argv[i + 1], target)) return bad_usage("%s needs a number, got '%s'", a, argv[i + 1]);
         i++;
+        scene_options = 1;
     }
-    if (steps >= 0 && seconds >= 0) { fprintf(stderr, "carom-run: give --steps or --seconds, not both\n"); return 2; }
-    if ((steps >= 0 && (steps < 1 || steps > 1e9 || steps != (long long)steps)) ||
-        (seconds >= 0 && !(seconds > 0 && seconds < 1e7)) || (dt >= 0 && !(dt > 0 && dt <= 1)) ||
-        (substeps >= 0 && !(substeps >= 1 && substeps <= 64 && substeps == (int)substeps))) {
-        fprintf(stderr, "carom-run: --steps must be a positive integer, --seconds positive, --dt in (0, 1], --substeps 1..64\n");
+    if (test && (scene || scene_options)) return bad_usage("--test runs a script plainly: give no scene and no scene options with it");
+    if (!test && !scene) {
+        usage(stderr);
         return 2;
     }
-    if (!scene && !test) { usage(stderr); return 2; }
+    if (steps >= 0 && seconds >= 0) return bad_usage("give --steps or --seconds, not both");
+    if (steps >= 0 && !(steps >= 1 && steps <= 1e9 && steps == floor(steps)))
+        return bad_usage("--steps must be a whole number from 1 to 1e9");
+    if (seconds >= 0 && !(seconds > 0 && seconds <= 1e7)) return bad_usage("--seconds must be positive (at most 1e7)");
+    if (dt >= 0 && !(dt > 0 && dt <= 1)) return bad_usage("--dt must be in (0, 1] seconds");
+    if (seconds > 0 && seconds / (dt > 0 ? dt : 1.0 / 60.0) > 1e9) return bad_usage("--seconds / --dt is more than 1e9 steps");
+    if (substeps >= 0 && !(substeps >= 1 && substeps <= 64 && substeps == floor(substeps)))
+        return bad_usage("--substeps must be a whole number from 1 to 64");
 
     lua_State *L = luaL_newstate();
-    if (!L) { fprintf(stderr, "carom-run: cannot create a Lua state\n"); return 1; }
+    if (!L) {
+        fprintf(stderr, "carom-run: cannot create a Lua state (out of memory)\n");
+        return 1;
+    }
     luaL_openlibs(L);
     luaL_getsubtable(L, LUA_REGISTRYINDEX, LUA_PRELOAD_TABLE);
     lua_pushcfunction(L, luaopen_carom);
     lua_setfield(L, -2, "carom");
     lua_pop(L, 1);
-    lua_pushcfunction(L, traceback);
+    set_arg(L, argv[0], test ? test : scene);
+    lua_pushcfunction(L, message_handler);
     int status;
     if (test) {
         status = luaL_loadfile(L, test);
@@ -155,18 +262,40 @@ int main(int argc, char **argv)
         status = luaL_loadbuffer(L, driver, sizeof driver - 1, "=carom-run");
         if (status == LUA_OK) {
             lua_createtable(L, 0, 8);
-            lua_pushstring(L, scene); lua_setfield(L, -2, "scene");
-            if (record) { lua_pushstring(L, record); lua_setfield(L, -2, "record"); }
-            if (steps >= 0) { lua_pushinteger(L, (lua_Integer)steps); lua_setfield(L, -2, "steps"); }
-            if (seconds >= 0) { lua_pushnumber(L, seconds); lua_setfield(L, -2, "seconds"); }
-            if (dt >= 0) { lua_pushnumber(L, dt); lua_setfield(L, -2, "dt"); }
-            if (substeps >= 0) { lua_pushinteger(L, (lua_Integer)substeps); lua_setfield(L, -2, "substeps"); }
-            lua_pushboolean(L, bench); lua_setfield(L, -2, "bench");
-            lua_pushboolean(L, quiet); lua_setfield(L, -2, "quiet");
+            lua_pushstring(L, scene);
+            lua_setfield(L, -2, "scene");
+            if (record) {
+                lua_pushstring(L, record);
+                lua_setfield(L, -2, "record");
+            }
+            if (steps >= 0) {
+                lua_pushinteger(L, (lua_Integer)steps);
+                lua_setfield(L, -2, "steps");
+            }
+            if (seconds >= 0) {
+                lua_pushnumber(L, seconds);
+                lua_setfield(L, -2, "seconds");
+            }
+            if (dt >= 0) {
+                lua_pushnumber(L, dt);
+                lua_setfield(L, -2, "dt");
+            }
+            if (substeps >= 0) {
+                lua_pushinteger(L, (lua_Integer)substeps);
+                lua_setfield(L, -2, "substeps");
+            }
+            lua_pushboolean(L, bench);
+            lua_setfield(L, -2, "bench");
+            lua_pushboolean(L, quiet);
+            lua_setfield(L, -2, "quiet");
             status = lua_pcall(L, 1, 0, 1);
         }
     }
-    status = report(L, status);
+    if (status != LUA_OK) {
+        const char *msg = lua_tostring(L, -1);
+        fflush(stdout);
+        fprintf(stderr, "carom-run: %s\n", msg ? msg : "(error object is not a string)");
+    }
     lua_close(L);
     return status == LUA_OK ? 0 : 1;
 }

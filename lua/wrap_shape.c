@@ -1,0 +1,276 @@
+/* wrap_shape.c - shape descriptors: carom.sphere{radius}, carom.box{half_extents},
+ * carom.capsule{radius, half_height}, carom.cylinder{radius, half_height},
+ * carom.hull{points}, carom.plane{normal, offset}. Each field may be given by
+ * name or by position (carom.capsule{0.1, 0.3}). A descriptor is validated
+ * when made and never changes; add_body copies it into the world, so one
+ * descriptor can serve many bodies. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "carom_lua.h"
+
+const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", NULL};
+
+/* Largest hull input accepted here; the world refuses hulls whose result is
+ * larger than its narrowphase holds, with its own message. */
+#define MAX_HULL_POINTS 100000
+
+clua_shape *clua_check_shape(lua_State *L, int arg, const char *fname)
+{
+    clua_shape *s = luaL_testudata(L, arg, CLUA_SHAPE_MT);
+    if (!s) clua_type_error(L, arg, fname, "shape (carom.sphere, box, capsule, cylinder, hull or plane)");
+    return s;
+}
+
+static clua_shape *new_shape(lua_State *L)
+{
+    clua_shape *s = lua_newuserdatauv(L, sizeof *s, 0);
+    memset(s, 0, sizeof *s);
+    luaL_setmetatable(L, CLUA_SHAPE_MT);
+    return s;
+}
+
+/* Checks the options table of a shape constructor: named keys from `names`,
+ * or positions 1..#names. */
+static void check_shape_args(lua_State *L, const char *fname, const char *const *names)
+{
+    clua_check_table(L, 1, fname);
+    int count = 0;
+    while (names[count]) count++;
+    lua_pushnil(L);
+    while (lua_next(L, 1)) {
+        lua_pop(L, 1);
+        int ok = 0;
+        if (lua_type(L, -1) == LUA_TSTRING) {
+            for (int i = 0; i < count; i++) ok |= strcmp(lua_tostring(L, -1), names[i]) == 0;
+            if (!ok) clua_arg_error(L, 1, fname, "unknown option '%s'", lua_tostring(L, -1));
+        } else if (lua_isinteger(L, -1)) {
+            lua_Integer i = lua_tointeger(L, -1);
+            if (i < 1 || i > count) clua_arg_error(L, 1, fname, "too many values (%s takes %d)", fname, count);
+        } else {
+            clua_arg_error(L, 1, fname, "option names must be strings, got a %s key", luaL_typename(L, -1));
+        }
+    }
+}
+
+/* Moves t[position] to t[name] in a private copy of the options table at 1,
+ * so the field readers below see one spelling; duplicates are an error. */
+static void normalise_positions(lua_State *L, const char *fname, const char *const *names)
+{
+    lua_newtable(L);
+    for (int i = 0; names[i]; i++) {
+        int by_name = lua_getfield(L, 1, names[i]) != LUA_TNIL;
+        int by_pos = lua_geti(L, 1, i + 1) != LUA_TNIL;
+        if (by_name && by_pos) clua_arg_error(L, 1, fname, "%s given twice (by name and by position)", names[i]);
+        if (by_name) lua_pop(L, 1);
+        else lua_remove(L, -2);
+        lua_setfield(L, -2, names[i]);
+    }
+    lua_replace(L, 1);
+}
+
+static double positive_field(lua_State *L, const char *fname, const char *key)
+{
+    double v = 0;
+    if (!clua_field_number(L, 1, fname, key, &v)) clua_arg_error(L, 1, fname, "%s is required", key);
+    if (!(v > 0)) clua_arg_error(L, 1, fname, "%s must be positive", key);
+    return v;
+}
+
+static int l_sphere(lua_State *L)
+{
+    static const char *const keys[] = {"radius", NULL};
+    check_shape_args(L, "sphere", keys);
+    normalise_positions(L, "sphere", keys);
+    double r = positive_field(L, "sphere", "radius");
+    new_shape(L)->def = carom_shape_sphere(r);
+    return 1;
+}
+
+static int l_box(lua_State *L)
+{
+    static const char *const keys[] = {"half_extents", NULL};
+    check_shape_args(L, "box", keys);
+    normalise_positions(L, "box", keys);
+    carom_vec3 h;
+    if (!clua_field_vec3(L, 1, "box", "half_extents", &h)) clua_arg_error(L, 1, "box", "half_extents is required");
+    if (!(h.x > 0 && h.y > 0 && h.z > 0)) clua_arg_error(L, 1, "box", "half_extents must be positive");
+    new_shape(L)->def = carom_shape_box(h.x, h.y, h.z);
+    return 1;
+}
+
+static int round_shape(lua_State *L, const char *fname, int capsule)
+{
+    static const char *const keys[] = {"radius", "half_height", NULL};
+    check_shape_args(L, fname, keys);
+    normalise_positions(L, fname, keys);
+    double r = positive_field(L, fname, "radius");
+    double h = positive_field(L, fname, "half_height");
+    new_shape(L)->def = capsule ? carom_shape_capsule(r, h) : carom_shape_cylinder(r, h);
+    return 1;
+}
+
+static int l_capsule(lua_State *L) { return round_shape(L, "capsule", 1); }
+static int l_cylinder(lua_State *L) { return round_shape(L, "cylinder", 0); }
+
+/* carom.hull{points = {{x,y,z}, ...}}, or the points directly: carom.hull{{x,y,z}, ...} */
+static int l_hull(lua_State *L)
+{
+    clua_check_table(L, 1, "hull");
+    int points_index;
+    int direct = lua_geti(L, 1, 1) == LUA_TTABLE && lua_geti(L, -1, 1) == LUA_TNUMBER;
+    lua_settop(L, 1);
+    if (direct) {
+        points_index = 1;
+        lua_pushnil(L);
+        while (lua_next(L, 1)) {
+            lua_pop(L, 1);
+            if (!lua_isinteger(L, -1)) clua_arg_error(L, 1, "hull", "a list of points takes no named options");
+        }
+    } else {
+        static const char *const keys[] = {"points", NULL};
+        check_shape_args(L, "hull", keys);
+        normalise_positions(L, "hull", keys);
+        if (lua_getfield(L, 1, "points") != LUA_TTABLE)
+            clua_arg_error(L, 1, "hull", "points must be a table of vectors {{x, y, z}, ...}");
+        points_index = lua_gettop(L);
+    }
+    lua_Integer n = (lua_Integer)lua_rawlen(L, points_index);
+    if (n < 4) clua_arg_error(L, 1, "hull", "a hull needs at least 4 points, got %d", (int)n);
+    if (n > MAX_HULL_POINTS) clua_arg_error(L, 1, "hull", "a hull takes at most %d points", MAX_HULL_POINTS);
+    clua_shape *s = new_shape(L); /* owns the array from here, so an error below cannot leak it */
+    s->points = malloc(sizeof(double) * 3 * (size_t)n);
+    if (!s->points) return luaL_error(L, "hull: out of memory");
+    for (lua_Integer i = 0; i < n; i++) {
+        lua_rawgeti(L, points_index, i + 1);
+        if (lua_type(L, -1) != LUA_TTABLE) clua_arg_error(L, 1, "hull", "point %d is not a vector {x, y, z}", (int)i + 1);
+        for (int c = 0; c < 3; c++) {
+            if (lua_geti(L, -1, c + 1) != LUA_TNUMBER) clua_arg_error(L, 1, "hull", "point %d is not a vector of 3 numbers", (int)i + 1);
+            double v = lua_tonumber(L, -1);
+            if (!isfinite(v)) clua_arg_error(L, 1, "hull", "point %d is not finite", (int)i + 1);
+            s->points[3 * i + c] = v;
+            lua_pop(L, 1);
+        }
+        lua_pop(L, 1);
+    }
+    s->def = carom_shape_hull(s->points, (int)n);
+    return 1;
+}
+
+static int l_plane(lua_State *L)
+{
+    static const char *const keys[] = {"normal", "offset", NULL};
+    if (lua_isnoneornil(L, 1)) {
+        lua_settop(L, 0);
+        lua_newtable(L);
+    }
+    check_shape_args(L, "plane", keys);
+    normalise_positions(L, "plane", keys);
+    carom_vec3 n = {0, 0, 1};
+    double offset = 0;
+    clua_field_vec3(L, 1, "plane", "normal", &n);
+    clua_field_number(L, 1, "plane", "offset", &offset);
+    if (n.x == 0 && n.y == 0 && n.z == 0) clua_arg_error(L, 1, "plane", "normal must not be zero");
+    double len = sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+    if (!isfinite(len)) clua_arg_error(L, 1, "plane", "normal is too long");
+    new_shape(L)->def = carom_shape_plane(n.x, n.y, n.z, offset);
+    return 1;
+}
+
+/* ---- metamethods ----------------------------------------------------------- */
+
+static int shape_gc(lua_State *L)
+{
+    clua_shape *s = luaL_checkudata(L, 1, CLUA_SHAPE_MT);
+    free(s->points);
+    s->points = NULL;
+    s->def.points = NULL;
+    s->def.point_count = 0;
+    return 0;
+}
+
+static int shape_tostring(lua_State *L)
+{
+    const carom_shape_def *d = &((clua_shape *)luaL_checkudata(L, 1, CLUA_SHAPE_MT))->def;
+    char buf[200];
+    switch (d->type) {
+    case CAROM_SHAPE_SPHERE: snprintf(buf, sizeof buf, "carom.sphere{radius = %g}", d->radius); break;
+    case CAROM_SHAPE_BOX:
+        snprintf(buf, sizeof buf, "carom.box{half_extents = {%g, %g, %g}}", d->half_extents.x, d->half_extents.y, d->half_extents.z);
+        break;
+    case CAROM_SHAPE_CAPSULE: snprintf(buf, sizeof buf, "carom.capsule{radius = %g, half_height = %g}", d->radius, d->half_height); break;
+    case CAROM_SHAPE_CYLINDER: snprintf(buf, sizeof buf, "carom.cylinder{radius = %g, half_height = %g}", d->radius, d->half_height); break;
+    case CAROM_SHAPE_HULL: snprintf(buf, sizeof buf, "carom.hull{%d points}", d->point_count); break;
+    default:
+        snprintf(buf, sizeof buf, "carom.plane{normal = {%g, %g, %g}, offset = %g}", d->normal.x, d->normal.y, d->normal.z, d->offset);
+        break;
+    }
+    lua_pushstring(L, buf);
+    return 1;
+}
+
+static int vec_eq(carom_vec3 a, carom_vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+/* Two descriptors are equal when they describe the same shape. */
+static int shape_eq(lua_State *L)
+{
+    clua_shape *a = luaL_testudata(L, 1, CLUA_SHAPE_MT), *b = luaL_testudata(L, 2, CLUA_SHAPE_MT);
+    int same = a && b && a->def.type == b->def.type;
+    if (same) {
+        const carom_shape_def *p = &a->def, *q = &b->def;
+        switch (p->type) {
+        case CAROM_SHAPE_SPHERE: same = p->radius == q->radius; break;
+        case CAROM_SHAPE_BOX: same = vec_eq(p->half_extents, q->half_extents); break;
+        case CAROM_SHAPE_CAPSULE:
+        case CAROM_SHAPE_CYLINDER: same = p->radius == q->radius && p->half_height == q->half_height; break;
+        case CAROM_SHAPE_HULL:
+            same = p->point_count == q->point_count &&
+                   (p->point_count == 0 || memcmp(p->points, q->points, sizeof(double) * 3 * (size_t)p->point_count) == 0);
+            break;
+        default: same = vec_eq(p->normal, q->normal) && p->offset == q->offset; break;
+        }
+    }
+    lua_pushboolean(L, same);
+    return 1;
+}
+
+/* shape.type, .radius, .half_height, .half_extents, .normal, .offset, .point_count (read only) */
+static int shape_index(lua_State *L)
+{
+    const carom_shape_def *d = &((clua_shape *)luaL_checkudata(L, 1, CLUA_SHAPE_MT))->def;
+    const char *k = lua_tostring(L, 2);
+    if (lua_type(L, 2) != LUA_TSTRING) lua_pushnil(L);
+    else if (strcmp(k, "type") == 0) lua_pushstring(L, clua_shape_names[d->type]);
+    else if (strcmp(k, "radius") == 0 && (d->type == CAROM_SHAPE_SPHERE || d->type == CAROM_SHAPE_CAPSULE || d->type == CAROM_SHAPE_CYLINDER))
+        lua_pushnumber(L, d->radius);
+    else if (strcmp(k, "half_height") == 0 && (d->type == CAROM_SHAPE_CAPSULE || d->type == CAROM_SHAPE_CYLINDER))
+        lua_pushnumber(L, d->half_height);
+    else if (strcmp(k, "half_extents") == 0 && d->type == CAROM_SHAPE_BOX) clua_push_vec3_table(L, d->half_extents);
+    else if (strcmp(k, "normal") == 0 && d->type == CAROM_SHAPE_PLANE) clua_push_vec3_table(L, d->normal);
+    else if (strcmp(k, "offset") == 0 && d->type == CAROM_SHAPE_PLANE) lua_pushnumber(L, d->offset);
+    else if (strcmp(k, "point_count") == 0 && d->type == CAROM_SHAPE_HULL) lua_pushinteger(L, d->point_count);
+    else lua_pushnil(L);
+    return 1;
+}
+
+static int shape_newindex(lua_State *L)
+{
+    return luaL_error(L, "shapes are immutable: make a new one (carom.%s{...})",
+                      clua_shape_names[((clua_shape *)luaL_checkudata(L, 1, CLUA_SHAPE_MT))->def.type]);
+}
+
+void clua_open_shapes(lua_State *L)
+{
+    static const luaL_Reg meta[] = {{"__gc", shape_gc}, {"__tostring", shape_tostring}, {"__eq", shape_eq},
+                                    {"__index", shape_index}, {"__newindex", shape_newindex}, {NULL, NULL}};
+    static const luaL_Reg constructors[] = {{"sphere", l_sphere}, {"box", l_box}, {"capsule", l_capsule},
+                                            {"cylinder", l_cylinder}, {"hull", l_hull}, {"plane", l_plane},
+                                            {NULL, NULL}};
+    luaL_newmetatable(L, CLUA_SHAPE_MT);
+    luaL_setfuncs(L, meta, 0);
+    lua_pushliteral(L, "locked");
+    lua_setfield(L, -2, "__metatable");
+    lua_pop(L, 1);
+    luaL_setfuncs(L, constructors, 0);
+}
