@@ -185,7 +185,8 @@ static void set_arg(lua_State *L, const char *program, const char *script)
 int main(int argc, char **argv)
 {
     const char *scene = NULL, *record = NULL, *test = NULL;
-    double steps = -1, seconds = -1, dt = -1, substeps = -1;
+    /* NAN: not given on the command line */
+    double steps = NAN, seconds = NAN, dt = NAN, substeps = NAN;
     int bench = 0, quiet = 0, scene_options = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -222,7 +223,7 @@ int main(int argc, char **argv)
         } else {
             return bad_usage("one scene at a time (got a second: %s)", a);
         }
-        if (*target >= 0) return bad_usage("%s given twice", a);
+        if (!isnan(*target)) return bad_usage("%s given twice", a);
         if (i + 1 >= argc) return bad_usage("%s needs a number", a);
         if (!parse_number(argv[i + 1], target)) return bad_usage("%s needs a number, got '%s'", a, argv[i + 1]);
         i++;
@@ -233,13 +234,13 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    if (steps >= 0 && seconds >= 0) return bad_usage("give --steps or --seconds, not both");
-    if (steps >= 0 && !(steps >= 1 && steps <= 1e9 && steps == floor(steps)))
+    if (!isnan(steps) && !isnan(seconds)) return bad_usage("give --steps or --seconds, not both");
+    if (!isnan(steps) && !(steps >= 1 && steps <= 1e9 && steps == floor(steps)))
         return bad_usage("--steps must be a whole number from 1 to 1e9");
-    if (seconds >= 0 && !(seconds > 0 && seconds <= 1e7)) return bad_usage("--seconds must be positive (at most 1e7)");
-    if (dt >= 0 && !(dt > 0 && dt <= 1)) return bad_usage("--dt must be in (0, 1] seconds");
-    if (seconds > 0 && seconds / (dt > 0 ? dt : 1.0 / 60.0) > 1e9) return bad_usage("--seconds / --dt is more than 1e9 steps");
-    if (substeps >= 0 && !(substeps >= 1 && substeps <= 64 && substeps == floor(substeps)))
+    if (!isnan(seconds) && !(seconds > 0 && seconds <= 1e7)) return bad_usage("--seconds must be positive (at most 1e7)");
+    if (!isnan(dt) && !(dt > 0 && dt <= 1)) return bad_usage("--dt must be in (0, 1] seconds");
+    if (!isnan(seconds) && seconds / (isnan(dt) ? 1.0 / 60.0 : dt) > 1e9) return bad_usage("--seconds / --dt is more than 1e9 steps");
+    if (!isnan(substeps) && !(substeps >= 1 && substeps <= 64 && substeps == floor(substeps)))
         return bad_usage("--substeps must be a whole number from 1 to 64");
 
     lua_State *L = luaL_newstate();
@@ -268,19 +269,19 @@ int main(int argc, char **argv)
                 lua_pushstring(L, record);
                 lua_setfield(L, -2, "record");
             }
-            if (steps >= 0) {
+            if (!isnan(steps)) {
                 lua_pushinteger(L, (lua_Integer)steps);
                 lua_setfield(L, -2, "steps");
             }
-            if (seconds >= 0) {
+            if (!isnan(seconds)) {
                 lua_pushnumber(L, seconds);
                 lua_setfield(L, -2, "seconds");
             }
-            if (dt >= 0) {
+            if (!isnan(dt)) {
                 lua_pushnumber(L, dt);
                 lua_setfield(L, -2, "dt");
             }
-            if (substeps >= 0) {
+            if (!isnan(substeps)) {
                 lua_pushinteger(L, (lua_Integer)substeps);
                 lua_setfield(L, -2, "substeps");
             }
