@@ -5,7 +5,7 @@
  *   carom-run --test script.lua
  *
  * A scene is a Lua file returning a table:
- *   { world = {options for carom.world}, steps = N, dt = DT,
+ *   { world = {options for carom.world}, steps = N (or seconds = S), dt = DT,
  *     load = function(world) end, update = function(world, dt) end,
  *     contact = function(event) end, report = function(world) end }
  * (every field optional). The runner makes the world, calls load, then for
@@ -32,7 +32,7 @@ int luaopen_carom(lua_State *L);
 
 /* The fixed-step loop, in Lua so that scenes and runner share one language.
  * Receives the options table built from the command line. */
-static const char driver[] =
+static const char driver_setup[] =
     "local carom = require 'carom'\n"
     "local opts = ...\n"
     "local chunk, err = loadfile(opts.scene)\n"
@@ -60,8 +60,10 @@ static const char driver[] =
     "local world = carom.world(wopts)\n"
     "local dt = opts.dt or positive_number(scene.dt, 'dt') or 1/60\n"
     "if dt > 1 then error(opts.scene .. ': scene.dt must be at most 1 s', 0) end\n"
-    "local steps = opts.steps or (opts.seconds and math.max(1, math.floor(opts.seconds / dt + 0.5)))\n"
-    "  or positive_number(scene.steps, 'steps', true) or 600\n"
+    "local function steps_in(seconds) return math.max(1, math.floor(seconds / dt + 0.5)) end\n"
+    "local steps = opts.steps or (opts.seconds and steps_in(opts.seconds))\n"
+    "  or positive_number(scene.steps, 'steps', true)\n"
+    "  or (positive_number(scene.seconds, 'seconds') and steps_in(scene.seconds)) or 600\n"
     "steps = math.tointeger(steps)\n"
     "if scene.contact then world:set_contact_callback(scene.contact) end\n"
     "if scene.load then scene.load(world) end\n"
@@ -81,6 +83,10 @@ static const char driver[] =
     "  end\n"
     "end\n"
     "if rec then record(0) end\n"
+    ;
+
+/* (two strings: C99 compilers need only support literals of 4095 characters) */
+static const char driver_loop[] =
     "local clock = carom.clock\n"
     "local window = math.max(1, steps // 50)\n"
     "local windows, wstart = {}, clock()\n"
@@ -260,7 +266,15 @@ int main(int argc, char **argv)
         status = luaL_loadfile(L, test);
         if (status == LUA_OK) status = lua_pcall(L, 0, 0, 1);
     } else {
-        status = luaL_loadbuffer(L, driver, sizeof driver - 1, "=carom-run");
+        luaL_Buffer code;
+        luaL_buffinit(L, &code);
+        luaL_addstring(&code, driver_setup);
+        luaL_addstring(&code, driver_loop);
+        luaL_pushresult(&code);
+        size_t length;
+        const char *text = lua_tolstring(L, -1, &length);
+        status = luaL_loadbuffer(L, text, length, "=carom-run");
+        lua_remove(L, -2); /* the source text */
         if (status == LUA_OK) {
             lua_createtable(L, 0, 8);
             lua_pushstring(L, scene);

@@ -140,6 +140,8 @@ test("--steps, --seconds, --dt, --substeps", function()
   assert(r.substeps == 9, "--substeps overrides the scene")
   r = result(expect(0, "RESULT", temp((io.open(probe_scene):read("a"):gsub("steps = 7, ", ""))), "--quiet"))
   assert(r.steps == 600, "600 steps when neither the scene nor the command line says")
+  r = result(expect(0, "RESULT", temp((io.open(probe_scene):read("a"):gsub("steps = 7, ", "seconds = 0.25, "))), "--quiet"))
+  assert(r.steps == 15, "the scene's seconds (0.25 s at 1/60 s)")
 end)
 
 test("--record writes every body's pose after every step", function()
