@@ -45,6 +45,22 @@ int clua_type_error(lua_State *L, int arg, const char *fname, const char *expect
     return clua_arg_error(L, arg, fname, "%s expected, got %s", expected, type_name(L, arg));
 }
 
+int clua_rawfield(lua_State *L, int t, const char *key)
+{
+    t = lua_absindex(L, t);
+    lua_pushstring(L, key);
+    return lua_rawget(L, t);
+}
+
+const char *clua_copy_error(const carom_world *world, char *buf, size_t size)
+{
+    const char *msg = carom_world_last_error(world);
+    const char *colon = strstr(msg, ": ");
+    if (colon && colon - msg < 40) msg = colon + 2; /* "body_set_mass: ..." */
+    snprintf(buf, size, "%s", msg);
+    return buf;
+}
+
 /* ---- plain arguments ------------------------------------------------------- */
 
 double clua_check_number(lua_State *L, int arg, const char *fname)
@@ -111,10 +127,10 @@ int clua_check_option(lua_State *L, int arg, const char *fname, const char *cons
 static int table_numbers(lua_State *L, int t, int n, const char *const *named, double *out)
 {
     t = lua_absindex(L, t);
-    int by_name = lua_geti(L, t, 1) == LUA_TNIL;
+    int by_name = lua_rawgeti(L, t, 1) == LUA_TNIL;
     lua_pop(L, 1);
     for (int i = 0; i < n; i++) {
-        int type = by_name ? lua_getfield(L, t, named[i]) : lua_geti(L, t, i + 1);
+        int type = by_name ? clua_rawfield(L, t, named[i]) : lua_rawgeti(L, t, i + 1);
         if (type != LUA_TNUMBER) { lua_pop(L, 1); return 0; }
         out[i] = lua_tonumber(L, -1);
         lua_pop(L, 1);
@@ -189,21 +205,45 @@ void clua_check_table(lua_State *L, int arg, const char *fname)
     if (lua_type(L, arg) != LUA_TTABLE) clua_type_error(L, arg, fname, "table of options");
 }
 
-void clua_check_keys(lua_State *L, int arg, const char *fname, const char *const *allowed)
+void clua_check_option_keys(lua_State *L, int arg, const char *fname, const char *const *allowed, int positions)
 {
     arg = lua_absindex(L, arg);
+    int odd_type = LUA_NUMTYPES; /* lowest type of a key that is neither a name nor a position */
+    int out_of_range = 0;
+    lua_pushnil(L); /* the alphabetically first unknown name */
+    int unknown = lua_gettop(L);
     lua_pushnil(L);
     while (lua_next(L, arg)) {
         lua_pop(L, 1);
-        if (lua_type(L, -1) != LUA_TSTRING) clua_arg_error(L, arg, fname, "option names must be strings, got a %s key", luaL_typename(L, -1));
-        if (find_name(lua_tostring(L, -1), allowed) < 0) clua_arg_error(L, arg, fname, "unknown option '%s'", lua_tostring(L, -1));
+        int t = lua_type(L, -1);
+        if (t == LUA_TSTRING) {
+            const char *k = lua_tostring(L, -1);
+            if (find_name(k, allowed) < 0 && (lua_isnil(L, unknown) || strcmp(k, lua_tostring(L, unknown)) < 0)) {
+                lua_pushvalue(L, -1);
+                lua_replace(L, unknown);
+            }
+        } else if (positions > 0 && lua_isinteger(L, -1)) {
+            lua_Integer i = lua_tointeger(L, -1);
+            if (i < 1 || i > positions) out_of_range = 1;
+        } else if (t < odd_type) {
+            odd_type = t;
+        }
     }
+    if (odd_type != LUA_NUMTYPES) clua_arg_error(L, arg, fname, "option names must be strings, got a %s key", lua_typename(L, odd_type));
+    if (out_of_range) clua_arg_error(L, arg, fname, "too many values (%s takes %d)", fname, positions);
+    if (!lua_isnil(L, unknown)) clua_arg_error(L, arg, fname, "unknown option '%s'", lua_tostring(L, unknown));
+    lua_pop(L, 1);
+}
+
+void clua_check_keys(lua_State *L, int arg, const char *fname, const char *const *allowed)
+{
+    clua_check_option_keys(L, arg, fname, allowed, 0);
 }
 
 /* Pushes t[key]; returns 0 (and pushes nothing) when it is nil. */
 static int get_field(lua_State *L, int arg, const char *key)
 {
-    if (lua_getfield(L, arg, key) != LUA_TNIL) return 1;
+    if (clua_rawfield(L, arg, key) != LUA_TNIL) return 1;
     lua_pop(L, 1);
     return 0;
 }

@@ -54,6 +54,18 @@ typedef struct clua_shape {
 
 /* ---- errors and arguments (carom_lua.c) ---------------------------------- */
 
+/* Script tables are read raw (no __index or __len), so no script code can
+ * run while arguments are being checked; and a carom_world pointer is read
+ * from its clua_world just before each C call, never kept across anything
+ * that may allocate (a collection may run a script's __gc finalizer, which
+ * may destroy a world). */
+
+/* Pushes t[key] without metamethods; returns its type. */
+int clua_rawfield(lua_State *L, int t, const char *key);
+/* Copies the world's last error message, without its "function: " prefix,
+ * into buf (the world's own buffer may not outlive the next allocation). */
+const char *clua_copy_error(const carom_world *world, char *buf, size_t size);
+
 /* Raises "bad argument #arg to 'fname' (message)". */
 int clua_arg_error(lua_State *L, int arg, const char *fname, const char *fmt, ...);
 /* Raises "bad argument #arg to 'fname' (expected expected, got <type>)". */
@@ -78,6 +90,11 @@ int clua_return_vec3(lua_State *L, carom_vec3 v);
  * reader returns 1 if the key is present (and then valid), 0 if absent. */
 void clua_check_table(lua_State *L, int arg, const char *fname);
 void clua_check_keys(lua_State *L, int arg, const char *fname, const char *const *allowed);
+/* The same, also allowing the positions 1..positions. Which error is raised
+ * does not depend on the table's traversal order (that changes from run to
+ * run): a key of another type first, then a position out of range, then the
+ * alphabetically first unknown name. */
+void clua_check_option_keys(lua_State *L, int arg, const char *fname, const char *const *allowed, int positions);
 int clua_field_number(lua_State *L, int arg, const char *fname, const char *key, double *out);
 int clua_field_int(lua_State *L, int arg, const char *fname, const char *key, int *out);
 int clua_field_bool(lua_State *L, int arg, const char *fname, const char *key, int *out);

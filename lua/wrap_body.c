@@ -107,9 +107,8 @@ static clua_world *body_world(lua_State *L, int arg)
 static int status_error(lua_State *L, carom_world *w, carom_status st, int arg, const char *fname)
 {
     if (st == CAROM_OK) return 0;
-    const char *msg = carom_world_last_error(w);
-    const char *colon = strstr(msg, ": ");
-    if (colon && colon - msg < 40) msg = colon + 2;
+    char buf[256];
+    const char *msg = clua_copy_error(w, buf, sizeof buf);
     if (st == CAROM_ERROR_INVALID_ARGUMENT && arg > 0) return clua_arg_error(L, arg, fname, "%s", msg);
     if (st == CAROM_ERROR_LOCKED) return luaL_error(L, "%s: cannot change a body inside a contact callback (%s)", fname, msg);
     return luaL_error(L, "%s: %s", fname, msg);
@@ -132,7 +131,7 @@ int clua_world_add_body(lua_State *L)
     carom_body_def d = carom_body_def_default();
     int type;
     if (clua_field_option(L, 2, fname, "type", clua_body_type_names, &type)) d.type = (carom_body_type)type;
-    if (lua_getfield(L, 2, "shape") == LUA_TNIL) clua_arg_error(L, 2, fname, "shape is required (e.g. shape = carom.sphere{radius = 0.5})");
+    if (clua_rawfield(L, 2, "shape") == LUA_TNIL) clua_arg_error(L, 2, fname, "shape is required (e.g. shape = carom.sphere{radius = 0.5})");
     clua_shape *s = luaL_testudata(L, -1, CLUA_SHAPE_MT);
     if (!s) clua_arg_error(L, 2, fname, "shape must be made by carom.sphere, box, capsule, cylinder, hull or plane, got %s", luaL_typename(L, -1));
     d.shape = s->def; /* s stays on the stack (so its hull points live) until the body is made */
@@ -157,8 +156,8 @@ int clua_world_add_body(lua_State *L)
     clua_field_bool(L, 2, fname, "lock_to_plane", &d.lock_to_plane);
     clua_field_bool(L, 2, fname, "sleep", &d.enable_sleep);
     clua_field_bool(L, 2, fname, "awake", &d.awake);
-    int has_user_data = lua_getfield(L, 2, "user_data") != LUA_TNIL;
-    int has_data = lua_getfield(L, 2, "data") != LUA_TNIL;
+    int has_user_data = clua_rawfield(L, 2, "user_data") != LUA_TNIL;
+    int has_data = clua_rawfield(L, 2, "data") != LUA_TNIL;
     if (has_user_data && has_data) clua_arg_error(L, 2, fname, "give user_data or data (the same field), not both");
     if (!has_data) lua_pop(L, 1);
     else lua_remove(L, -2); /* the user data value is now on top */
@@ -169,11 +168,11 @@ int clua_world_add_body(lua_State *L)
     lua_getiuservalue(L, 1, WORLD_UV_IDS);
     lua_getiuservalue(L, 1, WORLD_UV_DATA);
     if (!lua_checkstack(L, 8)) return luaL_error(L, "add_body: Lua stack overflow");
+    lw = clua_check_world(L, 1, fname); /* a finalizer run by the checks above may have destroyed it */
     carom_body_id id = carom_body_create(lw->world, &d);
     if (carom_body_id_is_null(id)) {
-        const char *msg = carom_world_last_error(lw->world);
-        const char *colon = strstr(msg, ": ");
-        if (colon && colon - msg < 40) msg = colon + 2;
+        char buf[256];
+        const char *msg = clua_copy_error(lw->world, buf, sizeof buf);
         if (strstr(msg, "inside step") || strstr(msg, "locked")) return luaL_error(L, "add_body: %s", msg);
         return clua_arg_error(L, 2, fname, "%s", msg);
     }
@@ -206,9 +205,10 @@ BODY_VEC_GETTER(local_center, carom_body_get_local_center)
     static int body_##name(lua_State *L)                               \
     {                                                                  \
         clua_body *b;                                                  \
-        carom_world *w = check_body(L, 1, #name, &b);                  \
+        check_body(L, 1, #name, &b);                                   \
         carom_vec3 v;                                                  \
         clua_check_vec3(L, 2, #name, &v);                              \
+        carom_world *w = check_body(L, 1, #name, &b);                  \
         return status_error(L, w, fn(w, b->id, v), 2, #name);          \
     }
 BODY_VEC_SETTER(set_position, carom_body_set_position)
@@ -250,6 +250,7 @@ static int body_set_orientation(lua_State *L)
     carom_world *w = check_body(L, 1, "set_orientation", &b);
     carom_quat q;
     clua_check_quat(L, 2, "set_orientation", &q);
+    w = check_body(L, 1, "set_orientation", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_orientation(w, b->id, q), 2, "set_orientation");
 }
 
@@ -263,6 +264,7 @@ static int body_apply_impulse(lua_State *L)
     int next = clua_check_vec3(L, 2, "apply_impulse", &j);
     int at_point = !lua_isnoneornil(L, next);
     if (at_point) clua_check_vec3(L, next, "apply_impulse", &p);
+    w = check_body(L, 1, "apply_impulse", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_apply_impulse(w, b->id, j, at_point ? &p : NULL), 2, "apply_impulse");
 }
 
@@ -272,6 +274,7 @@ static int body_set_mass(lua_State *L)
     carom_world *w = check_body(L, 1, "set_mass", &b);
     double m = clua_check_number(L, 2, "set_mass");
     if (!(m > 0)) clua_arg_error(L, 2, "set_mass", "mass must be positive");
+    w = check_body(L, 1, "set_mass", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_mass(w, b->id, m), 2, "set_mass");
 }
 
@@ -300,6 +303,7 @@ static int body_set_friction(lua_State *L)
     carom_world *w = check_body(L, 1, "set_friction", &b);
     double v = clua_check_number(L, 2, "set_friction");
     if (v < 0) clua_arg_error(L, 2, "set_friction", "friction must not be negative");
+    w = check_body(L, 1, "set_friction", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_friction(w, b->id, v), 2, "set_friction");
 }
 
@@ -309,6 +313,7 @@ static int body_set_restitution(lua_State *L)
     carom_world *w = check_body(L, 1, "set_restitution", &b);
     double v = clua_check_number(L, 2, "set_restitution");
     if (!(v >= 0 && v <= 1)) clua_arg_error(L, 2, "set_restitution", "restitution must be in [0, 1]");
+    w = check_body(L, 1, "set_restitution", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_restitution(w, b->id, v), 2, "set_restitution");
 }
 
@@ -317,6 +322,7 @@ static int body_set_gravity_scale(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_gravity_scale", &b);
     double v = clua_check_number(L, 2, "set_gravity_scale");
+    w = check_body(L, 1, "set_gravity_scale", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_gravity_scale(w, b->id, v), 2, "set_gravity_scale");
 }
 
@@ -325,6 +331,7 @@ static int body_set_bullet(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_bullet", &b);
     int v = clua_check_boolean(L, 2, "set_bullet");
+    w = check_body(L, 1, "set_bullet", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_bullet(w, b->id, v), 2, "set_bullet");
 }
 
@@ -343,6 +350,7 @@ static int body_set_type(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_type", &b);
     int t = clua_check_option(L, 2, "set_type", clua_body_type_names);
+    w = check_body(L, 1, "set_type", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_type(w, b->id, (carom_body_type)t), 2, "set_type");
 }
 
@@ -369,6 +377,7 @@ static int body_set_awake(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_awake", &b);
     int awake = clua_check_boolean(L, 2, "set_awake");
+    w = check_body(L, 1, "set_awake", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_awake(w, b->id, awake), 2, "set_awake");
 }
 

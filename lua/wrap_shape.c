@@ -38,20 +38,7 @@ static void check_shape_args(lua_State *L, const char *fname, const char *const 
     clua_check_table(L, 1, fname);
     int count = 0;
     while (names[count]) count++;
-    lua_pushnil(L);
-    while (lua_next(L, 1)) {
-        lua_pop(L, 1);
-        int ok = 0;
-        if (lua_type(L, -1) == LUA_TSTRING) {
-            for (int i = 0; i < count; i++) ok |= strcmp(lua_tostring(L, -1), names[i]) == 0;
-            if (!ok) clua_arg_error(L, 1, fname, "unknown option '%s'", lua_tostring(L, -1));
-        } else if (lua_isinteger(L, -1)) {
-            lua_Integer i = lua_tointeger(L, -1);
-            if (i < 1 || i > count) clua_arg_error(L, 1, fname, "too many values (%s takes %d)", fname, count);
-        } else {
-            clua_arg_error(L, 1, fname, "option names must be strings, got a %s key", luaL_typename(L, -1));
-        }
-    }
+    clua_check_option_keys(L, 1, fname, names, count);
 }
 
 /* Moves t[position] to t[name] in a private copy of the options table at 1,
@@ -60,8 +47,8 @@ static void normalise_positions(lua_State *L, const char *fname, const char *con
 {
     lua_newtable(L);
     for (int i = 0; names[i]; i++) {
-        int by_name = lua_getfield(L, 1, names[i]) != LUA_TNIL;
-        int by_pos = lua_geti(L, 1, i + 1) != LUA_TNIL;
+        int by_name = clua_rawfield(L, 1, names[i]) != LUA_TNIL;
+        int by_pos = lua_rawgeti(L, 1, i + 1) != LUA_TNIL;
         if (by_name && by_pos) clua_arg_error(L, 1, fname, "%s given twice (by name and by position)", names[i]);
         if (by_name) lua_pop(L, 1);
         else lua_remove(L, -2);
@@ -119,7 +106,7 @@ static int l_hull(lua_State *L)
 {
     clua_check_table(L, 1, "hull");
     int points_index;
-    int direct = lua_geti(L, 1, 1) == LUA_TTABLE && lua_geti(L, -1, 1) == LUA_TNUMBER;
+    int direct = lua_rawgeti(L, 1, 1) == LUA_TTABLE && lua_rawgeti(L, -1, 1) == LUA_TNUMBER;
     lua_settop(L, 1);
     if (direct) {
         points_index = 1;
@@ -132,7 +119,7 @@ static int l_hull(lua_State *L)
         static const char *const keys[] = {"points", NULL};
         check_shape_args(L, "hull", keys);
         normalise_positions(L, "hull", keys);
-        if (lua_getfield(L, 1, "points") != LUA_TTABLE)
+        if (clua_rawfield(L, 1, "points") != LUA_TTABLE)
             clua_arg_error(L, 1, "hull", "points must be a table of vectors {{x, y, z}, ...}");
         points_index = lua_gettop(L);
     }
@@ -146,7 +133,7 @@ static int l_hull(lua_State *L)
         lua_rawgeti(L, points_index, i + 1);
         if (lua_type(L, -1) != LUA_TTABLE) clua_arg_error(L, 1, "hull", "point %d is not a vector {x, y, z}", (int)i + 1);
         for (int c = 0; c < 3; c++) {
-            if (lua_geti(L, -1, c + 1) != LUA_TNUMBER) clua_arg_error(L, 1, "hull", "point %d is not a vector of 3 numbers", (int)i + 1);
+            if (lua_rawgeti(L, -1, c + 1) != LUA_TNUMBER) clua_arg_error(L, 1, "hull", "point %d is not a vector of 3 numbers", (int)i + 1);
             double v = lua_tonumber(L, -1);
             if (!isfinite(v)) clua_arg_error(L, 1, "hull", "point %d is not finite", (int)i + 1);
             s->points[3 * i + c] = v;

@@ -157,8 +157,12 @@ static int world_configure(lua_State *L)
     read_world_options(L, 2, "configure", &d, &fixed_dt, &max_steps);
     d.event_callback = world_event_callback;
     d.event_context = lw;
-    if (carom_world_set_def(lw->world, &d) != CAROM_OK)
-        return luaL_error(L, "configure: %s", carom_world_last_error(lw->world));
+    lw = clua_check_world(L, 1, "configure");
+    if (lw->stepping) return luaL_error(L, "configure: cannot change settings inside a contact callback");
+    if (carom_world_set_def(lw->world, &d) != CAROM_OK) {
+        char buf[256];
+        return luaL_error(L, "configure: %s", clua_copy_error(lw->world, buf, sizeof buf));
+    }
     if (fixed_dt != lw->fixed_dt) lw->accumulator = 0;
     lw->fixed_dt = fixed_dt;
     lw->max_steps = max_steps;
@@ -293,6 +297,7 @@ static void world_event_callback(void *context, const carom_contact_event *event
 /* One step of the world at index 1; raises a callback's error after it. */
 static void step_once(lua_State *L, clua_world *lw, double dt)
 {
+    if (!lw->world) luaL_error(L, "step: the world has been destroyed (by a finalizer?)");
     lw->stepping = L;
     lw->callback_failed = 0;
     carom_status st = carom_world_step(lw->world, dt);
@@ -308,7 +313,10 @@ static void step_once(lua_State *L, clua_world *lw, double dt)
         lua_setiuservalue(L, 1, WORLD_UV_ERROR);
         lua_error(L);
     }
-    if (st != CAROM_OK) luaL_error(L, "step: %s", carom_world_last_error(lw->world));
+    if (st != CAROM_OK) {
+        char buf[256];
+        luaL_error(L, "step: %s", clua_copy_error(lw->world, buf, sizeof buf));
+    }
 }
 
 /* world:step(dt[, n]): n steps (default 1), looping in C. */
@@ -366,9 +374,16 @@ static int world_events(lua_State *L)
     clua_world *lw = clua_check_world(L, 1, "events");
     const carom_contact_event *events = NULL;
     int n = carom_world_get_events(lw->world, &events);
-    lua_createtable(L, n > 0 ? n : 0, 0);
+    if (n < 0) n = 0;
+    /* a copy: building the tables may run a finalizer that steps or destroys the world */
+    carom_contact_event *copy = lua_newuserdatauv(L, sizeof *copy * (size_t)(n > 0 ? n : 1), 0);
+    lw = clua_check_world(L, 1, "events");
+    int now = carom_world_get_events(lw->world, &events);
+    if (now < n) n = now;
+    if (n > 0) memcpy(copy, events, sizeof *copy * (size_t)n);
+    lua_createtable(L, n, 0);
     for (int i = 0; i < n; i++) {
-        push_event(L, 1, &events[i]);
+        push_event(L, 1, &copy[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;
@@ -446,8 +461,10 @@ static int world_ray_cast(lua_State *L)
     int next = clua_check_vec3(L, 2, "ray_cast", &origin);
     clua_check_vec3(L, next, "ray_cast", &translation);
     carom_ray_hit hit;
+    lw = clua_check_world(L, 1, "ray_cast");
     int r = carom_world_ray_cast(lw->world, origin, translation, &hit);
-    if (r < 0) return clua_arg_error(L, next, "ray_cast", "%s", carom_world_last_error(lw->world));
+    char buf[256];
+    if (r < 0) return clua_arg_error(L, next, "ray_cast", "%s", clua_copy_error(lw->world, buf, sizeof buf));
     if (r == 0) {
         lua_pushnil(L);
         return 1;
@@ -468,9 +485,12 @@ static int world_query_aabb(lua_State *L)
     clua_check_vec3(L, next, "query_aabb", &hi);
     if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z)
         clua_arg_error(L, 2, "query_aabb", "the lower corner must not exceed the upper corner");
+    lw = clua_check_world(L, 1, "query_aabb");
     int n = carom_world_query_aabb(lw->world, lo, hi, NULL, 0);
-    if (n < 0) return clua_arg_error(L, 2, "query_aabb", "%s", carom_world_last_error(lw->world));
+    char buf[256];
+    if (n < 0) return clua_arg_error(L, 2, "query_aabb", "%s", clua_copy_error(lw->world, buf, sizeof buf));
     carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    lw = clua_check_world(L, 1, "query_aabb"); /* the allocation may have run a finalizer */
     int got = carom_world_query_aabb(lw->world, lo, hi, ids, n);
     if (got > n) got = n;
     lua_createtable(L, got > 0 ? got : 0, 0);

@@ -150,8 +150,36 @@ local function random_callback(w)
     if mode == 5 then pcall(w.step, w, 1 / 60) end
     if mode == 6 then pcall(w.destroy, w) end
     if mode == 7 and e.a then pcall(e.a.set_velocity, e.a, rnum(), rnum(), rnum()); local _ = tostring(e.b) end
-    if mode == 8 then collectgarbage("step") end
+    if mode == 8 then collectgarbage("collect") end -- finalizers run inside world:step
   end
+end
+
+-- Script code that runs at awkward moments: finalizers and metamethods on
+-- argument tables (which the bindings must never call). The automatic
+-- collector is stopped so that finalizers run only at the explicit full
+-- collections below (between calls, and inside contact callbacks, i.e. inside
+-- world:step): an incremental collector's timing depends on memory addresses,
+-- and the run must be the same every time. (lua_api_test.lua lets finalizers
+-- run at arbitrary allocations inside calls.)
+local function hostile_action(w, b)
+  local action = R(10)
+  return function()
+    if action == 1 and w then pcall(w.destroy, w)
+    elseif action == 2 and w then pcall(w.step, w, 1 / 60)
+    elseif action == 3 and b then pcall(b.destroy, b)
+    elseif action == 4 and w then pcall(w.add_body, w, { shape = carom.sphere{ radius = 0.5 } })
+    elseif action == 5 and b then pcall(b.set_position, b, 1, 2, 3) end
+  end
+end
+local function hostile_garbage()
+  for _ = 1, R(3) do
+    setmetatable({}, { __gc = hostile_action(worlds[R(math.max(#worlds, 1))], bodies[R(math.max(#bodies, 1))]) })
+  end
+end
+local function hostile_table(t)
+  local act = hostile_action(worlds[R(math.max(#worlds, 1))], bodies[R(math.max(#bodies, 1))])
+  return setmetatable(t, { __index = function() act(); return 1 end, __len = function() act(); return 3 end,
+                           __newindex = function() act() end, __pairs = function() act(); return next, {}, nil end })
 end
 
 local ok_calls, error_calls, bad_errors = 0, 0, 0
@@ -174,9 +202,16 @@ local function keep(list, v, limit)
 end
 
 local iteration = 0
+collectgarbage("stop")
 while call_number < CALLS do
   iteration = iteration + 1
-  local op = R(20)
+  local op = R(22)
+  -- mostly live worlds (a destroyed one stays until it is drawn here)
+  local wi = R(math.max(#worlds, 1))
+  if worlds[wi] and not worlds[wi]:is_valid() and rand() < 0.9 then table.remove(worlds, wi) end
+  local bi = R(math.max(#bodies, 1))
+  if bodies[bi] and not bodies[bi]:is_valid() and rand() < 0.7 then table.remove(bodies, bi) end
+  if rand() < 0.05 then hostile_garbage() end
   if op == 1 or #worlds == 0 then
     local ok, w = try("world", carom.world, rand() < 0.9 and world_options() or rany())
     if ok then keep(worlds, w, 6) end
@@ -220,6 +255,17 @@ while call_number < CALLS do
       w:set_contact_callback(nil)
       if not ok then error(err, 0) end
     end)
+  elseif op >= 21 then
+    local w = pick(worlds)
+    local k = R(4)
+    if k == 1 then
+      local ok, b = try("add_body (hostile table)", w.add_body, w, hostile_table(body_def()))
+      if ok then keep(bodies, b, 250) end
+    elseif k == 2 then try("configure (hostile table)", w.configure, w, hostile_table(world_options()))
+    elseif k == 3 and #bodies > 0 then
+      local b = pick(bodies)
+      try("set_velocity (hostile vector)", b.set_velocity, b, hostile_table({}))
+    else try("hull (hostile points)", carom.hull, hostile_table({ points = hostile_table({}) })) end
   else
     local w = pick(worlds)
     local m = pick(world_methods)
@@ -231,9 +277,10 @@ while call_number < CALLS do
       try(m, w[m], rand() < 0.95 and w or rany(), rany(), rany(), rany(), rany(), rany(), rany())
     end
   end
-  if iteration % 1000 == 0 then collectgarbage("collect") end
+  if iteration % 50 == 0 then collectgarbage("collect") end
 end
 
+collectgarbage("restart")
 print(string.format("fuzz (seed %d): %d calls, %d succeeded, %d raised Lua errors", SEED, call_number, ok_calls, error_calls))
 
 local passed, failed = 0, 0

@@ -767,6 +767,72 @@ test("a world collected while its bodies' userdata are unreachable too (cycle)",
   collectgarbage("collect")
 end)
 
+test("finalizers that destroy or step a world in the middle of a call cannot crash the host", function()
+  -- A collector that runs at almost every allocation, and garbage whose
+  -- finalizers destroy or step the world, made just before each call: they run
+  -- inside the call, e.g. while events() builds its tables from the world's
+  -- event buffer, which a step or a destroy replaces. (Before the bindings
+  -- copied that buffer, ASan caught a use after free here.)
+  collectgarbage("incremental", 1, 1000)
+  local ran, inside, calls = 0, 0, 0
+  local in_call = false
+  local probes = {
+    function(w, b) return w:events() end,
+    function(w, b) return w:add_body{ shape = sphere(0.1), position = { x = 3, y = 0, z = 0 }, user_data = {} } end,
+    function(w, b) return b:set_position{ x = 1, y = 2, z = 3 } end,
+    function(w, b) return b:apply_impulse({ x = 1, y = 0, z = 0 }, { x = 1, y = 2, z = 3 }) end,
+    function(w, b) return w:configure{ substeps = 2, gravity = { x = 0, y = 0, z = -1 } } end,
+    function(w, b) return w:step(1/60, 2) end,
+    function(w, b) return w:query_aabb({ x = -50, y = -5, z = -5 }, { x = 50, y = 5, z = 5 }) end,
+    function(w, b) return w:ray_cast({ x = -5, y = 0, z = 0 }, { x = 100, y = 0, z = 0 }) end,
+    function(w, b) return w:bodies() end,
+    function(w, b) return w:advance(0.05) end,
+    function(w, b) return tostring(b), w:stats(), w:settings() end,
+  }
+  for how = 1, 3 do
+    for _, probe in ipairs(probes) do
+      for _ = 1, 20 do
+        local w = carom.world{ gravity = {0, 0, 0} }
+        local b
+        for i = 1, 8 do -- overlapping pairs: events in every step
+          b = w:add_body{ position = {3 * i, 0, 0}, shape = sphere(0.5), velocity = {1, 0, 0} }
+          w:add_body{ position = {3 * i + 0.9, 0, 0}, shape = sphere(0.5), velocity = {-1, 0, 0} }
+        end
+        w:step(1/60)
+        for _ = 1, 3 do
+          setmetatable({}, { __gc = function()
+            ran = ran + 1
+            if in_call then inside = inside + 1 end
+            if how == 1 then pcall(w.destroy, w) elseif how == 2 then pcall(w.step, w, 1/60) else pcall(b.destroy, b) end
+          end })
+        end
+        in_call = true
+        pcall(probe, w, b)
+        in_call = false
+        calls = calls + 1
+      end
+    end
+  end
+  collectgarbage("collect")
+  collectgarbage("incremental", 200, 100) -- Lua 5.4's defaults
+  assert(ran == calls * 3, string.format("every finalizer ran: %d of %d", ran, calls * 3))
+  assert(inside > calls / 4, string.format("finalizers ran inside the calls: %d times in %d calls", inside, calls))
+end)
+
+test("argument tables are read raw: their metamethods never run", function()
+  local world = carom.world{}
+  local touched = false
+  local trap = { __index = function() touched = true end, __len = function() touched = true; return 3 end,
+                 __pairs = function() touched = true; return next, {}, nil end }
+  local b = world:add_body(setmetatable({ shape = sphere() }, trap))
+  b:set_position(setmetatable({ 1, 2, 3 }, trap))
+  raises("expected a vector", b.set_velocity, b, setmetatable({}, trap))
+  carom.hull{ points = setmetatable({{0,0,0},{1,0,0},{0,1,0},{0,0,1}}, trap) }
+  world:configure(setmetatable({}, trap))
+  assert(not touched, "a metamethod ran")
+  assert(select(3, b:position()) == 3)
+end)
+
 test("the module: version, clock", function()
   assert(carom.version == "1.0.0")
   local t0 = carom.clock()
