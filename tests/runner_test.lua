@@ -174,6 +174,34 @@ test("--test: exit 0 when the script passes, 1 when it raises or exits 1", funct
   expect(0, "carom 1.0.0", "--test", temp("print('carom ' .. require('carom').version)"))
 end)
 
+test("the module as a shared library: require 'carom' from the stand-alone lua5.4", function()
+  local dir = RUNNER:match("^(.*)/[^/]*$") or "."
+  local so = dir .. "/lua/carom.so"
+  local have_lua = os.execute("command -v lua5.4 >/dev/null 2>&1")
+  local f = io.open(so)
+  -- the sanitizer build's module cannot load into an uninstrumented lua5.4
+  if not have_lua or not f or dir:find("san", 1, true) then
+    if f then f:close() end
+    print("(skipped: no lua5.4 or no " .. so .. " for this build)")
+    return
+  end
+  f:close()
+  local script = temp(string.format([[
+package.cpath = %q
+local carom = require "carom"
+local w = carom.world{}
+w:add_body{ type = "static", shape = carom.plane{} }
+local ball = w:add_body{ position = {0, 0, 1}, shape = carom.sphere{ radius = 0.1 }, mass = 1 }
+w:step(1/60, 120)
+local _, _, z = ball:position()
+print(string.format("module %%s: ball at z = %%.3f", carom.version, z))
+]], dir .. "/lua/?.so"))
+  local out = temp()
+  local _, _, code = os.execute("lua5.4 " .. quote(script) .. " >" .. quote(out) .. " 2>&1")
+  local text = io.open(out):read("a")
+  assert(code == 0 and text:find("module 1.0.0: ball at z = 0.100", 1, true), text)
+end)
+
 for _, name in ipairs(temporaries) do os.remove(name) end
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end
