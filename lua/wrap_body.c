@@ -87,7 +87,7 @@ static carom_world *check_body(lua_State *L, int arg, const char *fname, clua_bo
     clua_body *b = luaL_testudata(L, arg, CLUA_BODY_MT);
     if (!b) clua_type_error(L, arg, fname, CLUA_BODY_MT);
     lua_getiuservalue(L, arg, BODY_UV_WORLD);
-    clua_world *lw = lua_touserdata(L, -1);
+    clua_world *lw = luaL_testudata(L, -1, CLUA_WORLD_MT);
     lua_pop(L, 1);
     if (!lw || !lw->world) clua_arg_error(L, arg, fname, "the body's world has been destroyed");
     if (!carom_body_is_valid(lw->world, b->id)) clua_arg_error(L, arg, fname, "body has been destroyed");
@@ -98,7 +98,7 @@ static carom_world *check_body(lua_State *L, int arg, const char *fname, clua_bo
 static clua_world *body_world(lua_State *L, int arg)
 {
     lua_getiuservalue(L, arg, BODY_UV_WORLD);
-    clua_world *lw = lua_touserdata(L, -1);
+    clua_world *lw = luaL_testudata(L, -1, CLUA_WORLD_MT);
     lua_pop(L, 1);
     return lw;
 }
