@@ -454,11 +454,13 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
         double s = poly_min_along(pb, pa->fn[f]) - pa->fd[f];
         if (s > sa_best) { sa_best = s; fa = f; }
     }
+    if (fa < 0) return; /* non-finite distances: no contact */
     if (sa_best > spec) { m->normal = pa->fn[fa]; return; }
     for (int f = 0; f < pb->nf; f++) {
         double s = poly_min_along(pa, pb->fn[f]) - pb->fd[f];
         if (s > sb_best) { sb_best = s; fb = f; }
     }
+    if (fb < 0) return;
     if (sb_best > spec) { m->normal = v3_neg(pb->fn[fb]); return; }
     /* edge pairs: only those whose Gauss-map arcs cross (they bound a face of
      * the Minkowski difference); for them the edges' own points give the
@@ -619,6 +621,7 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
         double s = dmin(v3_dot(p->fn[f], c0), v3_dot(p->fn[f], c1)) - p->fd[f];
         if (s > best) { best = s; bf = f; }
     }
+    if (bf < 0) return; /* no finite face distance */
     vec3 n = p->fn[bf];
     /* clip the core (point or segment) to the reference face's side planes */
     clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
@@ -709,10 +712,18 @@ static void collide_ordered(const shape *a, xform xa, const shape *b, xform xb, 
     else poly_poly(a, xa, b, xb, spec, cache, m);
 }
 
+static int xform_is_finite(xform x)
+{
+    return v3_is_finite(x.p) && isfinite(x.q.x) && isfinite(x.q.y) && isfinite(x.q.z) && isfinite(x.q.w);
+}
+
 int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache, manifold *m)
 {
     memset(m, 0, sizeof *m);
     m->normal = v3(0, 0, 1);
+    /* a pose that overflowed has no contacts (the feature searches below would
+     * find no best face and index with -1) */
+    if (!xform_is_finite(xa) || !xform_is_finite(xb)) return 0;
     int swap = a->type > b->type;
     /* capsule (2) against box (1) is handled box-first; everything else by type order */
     if (swap) {

@@ -217,6 +217,18 @@ static void project_planar(carom_world *w, int nb)
     }
 }
 
+/* Scales v back to length max (counting it); overflow-safe for huge finite v. */
+static vec3 clamp_length(vec3 v, double max, int *clamped)
+{
+    double m = dmax(fabs(v.x), dmax(fabs(v.y), fabs(v.z)));
+    if (!(m > max / 2)) return v; /* |v| <= sqrt(3) m, and NaN passes to the guard */
+    vec3 u = v3_scale(v, 1.0 / m); /* no overflow in the length */
+    double len = m * v3_len(u);
+    if (len <= max) return v;
+    (*clamped)++;
+    return v3_scale(u, max / v3_len(u));
+}
+
 #define SHOCK_MASS_RATIO 4.0
 #define RESTITUTION_PASSES 4
 
@@ -272,7 +284,7 @@ int world_solve(carom_world *w, double dt)
     double h = dt / substeps;
 
     /* gather awake bodies: index 0 is the shared immovable body */
-    int nb = 1;
+    int nb = 1, clamped = 0;
     for (int i = 0; i < bs->count; i++) bs->solver_index[i] = 0;
     if (!array_reserve((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
     {
@@ -298,8 +310,10 @@ int world_solve(carom_world *w, double dt)
         int k = nb++;
         bs->solver_index[i] = k;
         s->body_slot[k] = i;
-        bodies[k].v = bs->velocity[i];
-        bodies[k].w = bs->angular_velocity[i];
+        /* clamp before integrating: a finite but huge velocity set by the user
+         * would otherwise overflow the pose to inf/NaN within the step */
+        bodies[k].v = clamp_length(bs->velocity[i], def->max_linear_speed, &clamped);
+        bodies[k].w = clamp_length(bs->angular_velocity[i], def->max_angular_speed, &clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
         s->delta_position[k] = v3_zero();
@@ -516,19 +530,21 @@ int world_solve(carom_world *w, double dt)
     }
 
     /* write velocities back; clamp and guard */
-    int clamped = 0, awake = 0;
+    int awake = 0;
     double vmax = def->max_linear_speed, wmax = def->max_angular_speed;
     for (int b = 1; b < nb; b++) {
         int slot = s->body_slot[b];
         vec3 v = bodies[b].v, av = bodies[b].w;
-        double sp = v3_len(v), ap = v3_len(av);
-        if (sp > vmax) { v = v3_scale(v, vmax / sp); clamped++; }
-        if (ap > wmax) { av = v3_scale(av, wmax / ap); clamped++; }
-        if (!v3_is_finite(v) || !v3_is_finite(av) || !v3_is_finite(bs->center[slot])) {
+        v = clamp_length(v, vmax, &clamped);
+        av = clamp_length(av, wmax, &clamped);
+        quat q = bs->rotation[slot];
+        if (!v3_is_finite(v) || !v3_is_finite(av) || !v3_is_finite(bs->center[slot]) ||
+            !(isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z))) {
             /* never propagate NaN: undo this step's motion and stop the body */
             bs->center[slot] = v3_sub(bs->center[slot], s->delta_position[b]);
             if (!v3_is_finite(bs->center[slot])) bs->center[slot] = v3_zero();
-            bs->rotation[slot] = q_normalize(bs->rotation[slot]);
+            s->delta_position[b] = v3_zero(); /* nothing for continuous collision to sweep */
+            bs->rotation[slot] = q_normalize(q); /* identity if it overflowed */
             v = v3_zero();
             av = v3_zero();
             w->stats.non_finite++;

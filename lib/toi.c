@@ -93,7 +93,7 @@ void world_continuous(carom_world *w, double dt)
         double travel = v3_len(delta);
         int bullet = (s->flags[i] & BODY_BULLET) != 0;
         if (!bullet && travel <= min_extent(&s->shapes[i])) continue;
-        if (travel <= 0) continue;
+        if (!(travel > 0) || !isfinite(travel)) continue;
         sweep_query q = {w, i, v3_sub(s->center[i], delta), s->center[i], bullet, 1.0,
                          dmax(0.5 * w->def.linear_slop, 1e-4)};
         aabb a0 = shape_aabb(&s->shapes[i], (xform){v3_sub(body_origin(s, i), delta), s->rotation[i]});

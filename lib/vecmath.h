@@ -73,7 +73,7 @@ static inline double q_len(quat a) { return sqrt(a.w * a.w + a.x * a.x + a.y * a
 static inline quat q_normalize(quat a)
 {
     double l = q_len(a);
-    if (!(l > 1e-300)) return q_identity();
+    if (!(l > 1e-300) || !isfinite(l)) return q_identity();
     quat r = {a.w / l, a.x / l, a.y / l, a.z / l};
     return r;
 }

@@ -172,6 +172,47 @@ static void test_time_steps(void **state)
 }
 
 /* A short soak: a box and a ball bouncing around a closed room stay finite and inside. */
+/* Finite but absurd velocities (the setters accept any finite value) are
+ * clamped to the world's speed limits before they are integrated: no pose
+ * overflows, no NaN reaches the narrowphase or the time-of-impact sweep. */
+static void test_huge_velocities(void **state)
+{
+    (void)state;
+    const carom_shape_def shapes[] = {carom_shape_capsule(0.1, 0.3), carom_shape_sphere(0.2), carom_shape_box(0.2, 0.2, 0.2)};
+    for (int k = 0; k < 3; k++) {
+        carom_world_def d = carom_world_def_default();
+        carom_world *w = ground_world(d);
+        carom_body_def sb = carom_body_def_default();
+        sb.type = CAROM_BODY_STATIC;
+        sb.shape = carom_shape_box(2, 2, 0.5);
+        sb.position = vec(0, 0, 0.5);
+        carom_body_create(w, &sb);
+        carom_body_def bd = carom_body_def_default();
+        bd.shape = shapes[k];
+        bd.position = vec(0, 0, 1.6);
+        carom_body_id spin = carom_body_create(w, &bd);
+        bd.position = vec(0.5, 0, 1.6);
+        carom_body_id fly = carom_body_create(w, &bd);
+        assert_int_equal(carom_body_set_angular_velocity(w, spin, vec(0, -1e308, 0)), CAROM_OK);
+        assert_int_equal(carom_body_set_linear_velocity(w, fly, vec(-1e308, 1e308, -1e308)), CAROM_OK);
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        carom_world_stats st = carom_world_stats_init();
+        assert_int_equal(carom_world_get_stats(w, &st), CAROM_OK);
+        assert_true(st.clamped >= 2);
+        assert_int_equal(st.non_finite, 0);
+        carom_vec3 wv, v;
+        assert_int_equal(carom_body_get_angular_velocity(w, spin, &wv), CAROM_OK);
+        assert_true(sqrt(wv.x * wv.x + wv.y * wv.y + wv.z * wv.z) <= d.max_angular_speed * (1 + 1e-12));
+        assert_int_equal(carom_body_get_linear_velocity(w, fly, &v), CAROM_OK);
+        assert_true(sqrt(v.x * v.x + v.y * v.y + v.z * v.z) <= d.max_linear_speed * (1 + 1e-12));
+        run(w, 120, 1.0 / 60);
+        assert_world_finite(w);
+        carom_vec3 p = pos(w, spin);
+        assert_true(isfinite(p.x) && isfinite(p.y) && isfinite(p.z));
+        carom_world_destroy(w);
+    }
+}
+
 static void test_soak(void **state)
 {
     (void)state;
@@ -214,6 +255,7 @@ int main(void)
         cmocka_unit_test(test_sizes),
         cmocka_unit_test(test_far_from_origin),
         cmocka_unit_test(test_time_steps),
+        cmocka_unit_test(test_huge_velocities),
         cmocka_unit_test(test_soak),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -791,6 +791,34 @@ static void test_every_pair_is_finite(void **state)
     hull_free(shapes[4].hull);
 }
 
+/* A pose that overflowed (inf/NaN position or rotation) gives no contact for
+ * every pair type, and no feature search indexes with "no best face". */
+static void test_non_finite_poses_give_no_contact(void **state)
+{
+    (void)state;
+    double pts[21] = {0.3, 0, 0, -0.3, 0, 0, 0, 0.3, 0, 0, -0.3, 0, 0, 0, 0.4, 0, 0, -0.4, 0.1, 0.1, 0.1};
+    shape shapes[6] = {sphere(0.4), box(0.3, 0.4, 0.5), capsule(0.2, 0.4), cylinder(0.35, 0.3), make(SHAPE_HULL),
+                       ground()};
+    shapes[4] = hull_shape(pts, 7);
+    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    for (int a = 0; a < SHAPE_TYPE_COUNT; a++)
+        for (int b = 0; b < SHAPE_TYPE_COUNT; b++)
+            for (int k = 0; k < 12; k++) {
+                xform xa = at(0, 0, 0), xb = at(0.1, 0, 0.2);
+                xform *x = k % 2 ? &xb : &xa;
+                if (k / 2 % 2) x->p.y = bad[k / 4];
+                else x->q.x = bad[k / 4];
+                manifold m;
+                collide_cache cache;
+                memset(&cache, 0, sizeof cache);
+                cache.feature = -1;
+                assert_int_equal(collide(&shapes[a], xa, &shapes[b], xb, 0.02, &cache, &m), 0);
+                assert_int_equal(m.count, 0);
+                assert_true(v3_is_finite(m.normal));
+            }
+    hull_free(shapes[4].hull);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -807,6 +835,7 @@ int main(void)
         cmocka_unit_test(test_hull_boxes_agree_with_box_path),
         cmocka_unit_test(test_feature_ids_survive_jitter),
         cmocka_unit_test(test_every_pair_is_finite),
+        cmocka_unit_test(test_non_finite_poses_give_no_contact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
