@@ -3,6 +3,7 @@
  * and raises begin/end events. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "world.h"
 
 static void add_pair(void *ctx, int ida, int idb)
@@ -22,13 +23,23 @@ static void add_pair(void *ctx, int ida, int idb)
     c->restitution = dmax(s->restitution[a], s->restitution[b]);
 }
 
-void world_update_pairs(carom_world *w)
+int world_update_pairs(carom_world *w)
 {
     body_store *s = &w->bodies;
+    step_scratch *sc = &w->scratch;
     double dt = w->last_dt;
+    if (!array_reserve((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
+    /* the pose array shares the capacity: grow it to match */
+    int cap = sc->slot_capacity;
+    void *grown = realloc(sc->pose, sizeof *sc->pose * (size_t)(cap > 0 ? cap : 1));
+    if (!grown) return 0;
+    sc->pose = grown;
     for (int i = 0; i < s->count; i++) {
         if (s->type[i] == CAROM_BODY_STATIC || !(s->flags[i] & BODY_AWAKE)) continue;
-        aabb box = world_body_fat_aabb(w, i, 0.0);
+        /* the frame and tight bounds once per body, for every pair it is in */
+        sc->pose[i] = body_xform(s, i);
+        sc->tight_box[i] = shape_aabb(&s->shapes[i], sc->pose[i]);
+        aabb box = aabb_fatten(sc->tight_box[i], w->def.speculative_distance);
         /* bullets and fast bodies: the box covers this step's travel so their
          * speculative contacts exist before they arrive */
         vec3 travel = v3_scale(s->velocity[i], dt);
@@ -43,6 +54,7 @@ void world_update_pairs(carom_world *w)
         }
     }
     bp_update_pairs(w->bp, add_pair, w);
+    return 1;
 }
 
 static void push_touch_event(carom_world *w, const contact *c, carom_event_type type)
@@ -60,44 +72,72 @@ static void push_touch_event(carom_world *w, const contact *c, carom_event_type 
     world_push_event(w, &e);
 }
 
-void world_collide(carom_world *w)
+/* Wakes a sleeping body during the collision stage; its later pairs read
+ * this step's frame and bounds like every awake body's. */
+static void wake_for_step(carom_world *w, int slot)
+{
+    body_store *s = &w->bodies;
+    world_wake_body(w, slot);
+    if (s->type[slot] == CAROM_BODY_STATIC) return;
+    w->scratch.pose[slot] = body_xform(s, slot);
+    w->scratch.tight_box[slot] = shape_aabb(&s->shapes[slot], w->scratch.pose[slot]);
+}
+
+int world_collide(carom_world *w)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     double speculative = w->def.speculative_distance;
     double dt = w->last_dt;
-    for (int i = cs->count - 1; i >= 0; i--) {
+    step_scratch *sc = &w->scratch;
+    sc->touching_count = 0;
+    /* at most every contact is touching: reserve once, so nothing below can fail */
+    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
+    /* ascending, and a removal re-examines index i (the last contact, not yet
+     * seen, moves there), so the indices already listed stay valid */
+    for (int i = 0; i < cs->count;) {
         contact *c = &cs->items[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
         int awake_a = s->type[a] != CAROM_BODY_STATIC && (s->flags[a] & BODY_AWAKE);
         int awake_b = s->type[b] != CAROM_BODY_STATIC && (s->flags[b] & BODY_AWAKE);
         c->flags &= ~(uint32_t)CONTACT_SIM;
-        if (!awake_a && !awake_b) continue; /* a sleeping pair keeps its manifold */
+        if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
             if (c->flags & CONTACT_TOUCHING) push_touch_event(w, c, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
-        xform xa = body_xform(s, a), xb = body_xform(s, b);
         /* a fast pair looks ahead by its closing travel this step */
         double spec = speculative;
         double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
         if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
-        manifold old_m = c->m;
-        contact_point_state old_state[MANIFOLD_MAX_POINTS];
-        memcpy(old_state, c->state, sizeof old_state);
-        collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
-        contact_match_points(c, &old_m, old_state, xa);
+        /* bounds farther apart than the look-ahead: no point can be within it
+         * (the gap between boxes bounds the distance), so skip the narrowphase */
+        aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
+        if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
+            xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
+            manifold old_m = c->m;
+            contact_point_state old_state[MANIFOLD_MAX_POINTS];
+            /* only the live entries: most pairs near contact have none */
+            memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
+            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
+            if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
+        } else {
+            c->m.count = 0;
+        }
         int touching = c->m.count > 0;
         int was = (c->flags & CONTACT_TOUCHING) != 0;
         c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
                    (touching ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
         if (touching && (!awake_a || !awake_b)) {
             /* an awake body touching a sleeping one wakes it for this very step */
-            if (!awake_a) world_wake_body(w, a);
-            if (!awake_b) world_wake_body(w, b);
+            if (!awake_a) wake_for_step(w, a);
+            if (!awake_b) wake_for_step(w, b);
         }
         if (touching && !was) push_touch_event(w, c, CAROM_EVENT_BEGIN);
         else if (!touching && was) push_touch_event(w, c, CAROM_EVENT_END);
+        if (touching) sc->touching[sc->touching_count++] = i;
+        i++;
     }
+    return 1;
 }

@@ -24,18 +24,9 @@ softness make_softness(double hertz, double zeta, double h)
     return s;
 }
 
-typedef struct solve_context {
-    impulse_body *bodies;
-    vec3 *dp, *dq;
-    double inv_h;
-    double push_max, slop, baumgarte;
-    carom_position_correction correction;
-    int friction;
-} solve_context;
-
 /* Normal then friction rows of one manifold; use_bias selects the solve pass
  * (position error fed back) over the relax pass (velocity only). */
-static void solve_constraint(contact_constraint *c, const solve_context *sc, int use_bias)
+void solve_constraint(contact_constraint *c, const solve_context *sc, int use_bias)
 {
     impulse_body *A = &sc->bodies[c->a], *B = &sc->bodies[c->b];
     vec3 vA = A->v, wA = A->w, vB = B->v, wB = B->w;
@@ -155,20 +146,22 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
     }
 }
 
+void warm_start_constraint(contact_constraint *c, impulse_body *bodies)
+{
+    impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
+                        v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
+        p->total_normal_impulse += p->normal_impulse;
+        /* seed convention: body 1 = B receives +P (n points from A to B) */
+        impulse_apply(B, A, p->rb, p->ra, P);
+    }
+}
+
 static void warm_start(contact_constraint *cc, int n, impulse_body *bodies)
 {
-    for (int k = 0; k < n; k++) {
-        contact_constraint *c = &cc[k];
-        impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
-        for (int i = 0; i < c->count; i++) {
-            constraint_point *p = &c->p[i];
-            vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
-                            v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
-            p->total_normal_impulse += p->normal_impulse;
-            /* seed convention: body 1 = B receives +P (n points from A to B) */
-            impulse_apply(B, A, p->rb, p->ra, P);
-        }
-    }
+    for (int k = 0; k < n; k++) warm_start_constraint(&cc[k], bodies);
 }
 
 static void apply_restitution(contact_constraint *cc, int n, impulse_body *bodies, double threshold, int friction)
@@ -229,6 +222,11 @@ static vec3 clamp_length(vec3 v, double max, int *clamped)
     return v3_scale(u, max / v3_len(u));
 }
 
+/* Below this many manifolds the wide passes gain nothing (mostly empty
+ * lanes), and the scalar order converges faster on a small stack: colours
+ * interleave its contacts (red-black), so support climbs two boxes per sweep
+ * instead of the whole stack. */
+#define WIDE_MIN_CONSTRAINTS 64
 #define SHOCK_MASS_RATIO 4.0
 #define RESTITUTION_PASSES 4
 
@@ -321,12 +319,9 @@ int world_solve(carom_world *w, double dt)
     }
 
     /* constraints from touching manifolds */
-    int ncon = 0, npoints = 0;
-    for (int i = 0; i < cs->count; i++)
-        if ((cs->items[i].flags & (CONTACT_SIM | CONTACT_TOUCHING)) == (CONTACT_SIM | CONTACT_TOUCHING)) {
-            ncon++;
-            npoints += cs->items[i].m.count;
-        }
+    /* the collision stage listed them: no scan over every pair */
+    int ncon = s->touching_count, npoints = 0;
+    for (int c = 0; c < ncon; c++) npoints += cs->items[s->touching[c]].m.count;
     /* one block: constraints, then their points packed (most pairs of round
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
@@ -348,9 +343,9 @@ int world_solve(carom_world *w, double dt)
     int contacts_touching = 0, points = 0;
 
     int k = 0;
-    for (int i = 0; i < cs->count; i++) {
+    for (int t = 0; t < ncon; t++) {
+        int i = s->touching[t];
         contact *ct = &cs->items[i];
-        if ((ct->flags & (CONTACT_SIM | CONTACT_TOUCHING)) != (CONTACT_SIM | CONTACT_TOUCHING)) continue;
         int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
         contact_constraint *c = &cc[k++];
         c->a = bs->solver_index[sa];
@@ -435,6 +430,14 @@ int world_solve(carom_world *w, double dt)
         if (shock) shock = compute_levels(cc, ncon, bodies, level, nb, order, count_buf);
     }
 
+    /* the wide passes; shock propagation and penalty springs keep the scalar
+     * order (the shock pass reads each point's impulse between passes) */
+    wide_set *wide = NULL;
+    if (!penalty && !shock && ncon >= WIDE_MIN_CONSTRAINTS) {
+        wide = wide_build(&s->wide, &s->wide_capacity, cc, ncon, nb);
+        if (!wide) return 0;
+    }
+
     solve_context sc = {bodies, s->delta_position, s->delta_rotation, 1.0 / h,
                         def->contact_push_max_velocity, def->linear_slop, def->baumgarte,
                         def->position_correction, friction_on};
@@ -455,9 +458,14 @@ int world_solve(carom_world *w, double dt)
         if (penalty) {
             penalty_solve(w, cc, ncon, h);
         } else {
-            if (def->warm_starting) warm_start(cc, ncon, bodies);
-            for (int it = 0; it < def->iterations; it++)
-                for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 1);
+            if (def->warm_starting) {
+                if (wide) wide_warm_start(wide, cc, bodies);
+                else warm_start(cc, ncon, bodies);
+            }
+            for (int it = 0; it < def->iterations; it++) {
+                if (wide) wide_solve(wide, cc, &sc, 1);
+                else for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 1);
+            }
             for (int o = 0; o < shock; o++) {
                 contact_constraint *c = &cc[order[o]];
                 solve_constraint_shock(c, &sc, 1, level[c->a] < level[c->b]);
@@ -477,8 +485,10 @@ int world_solve(carom_world *w, double dt)
             }
         }
         if (!penalty) {
-            for (int it = 0; it < def->relax_iterations; it++)
-                for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 0);
+            for (int it = 0; it < def->relax_iterations; it++) {
+                if (wide) wide_solve(wide, cc, &sc, 0);
+                else for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 0);
+            }
             if (def->relax_iterations > 0)
                 for (int o = 0; o < shock; o++) {
                     contact_constraint *c = &cc[order[o]];
@@ -487,6 +497,7 @@ int world_solve(carom_world *w, double dt)
             project_planar(w, nb);
         }
     }
+    if (wide) wide_store(wide, cc);
     if (!penalty && def->enable_restitution) {
         /* a few passes: simultaneous impacts (a ball meeting a wall and a ball at once)
          * need the impulses to agree, which one Gauss-Seidel sweep does not give */

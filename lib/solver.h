@@ -40,6 +40,32 @@ typedef struct contact_constraint {
 
 softness make_softness(double hertz, double damping_ratio, double h);
 
+/* What one solve pass reads besides the constraints. */
+typedef struct solve_context {
+    impulse_body *bodies;
+    vec3 *dp, *dq;               /* per solver body: motion since the step began */
+    double inv_h;
+    double push_max, slop, baumgarte;
+    carom_position_correction correction;
+    int friction;
+} solve_context;
+
+/* The scalar pass over one manifold (solver.c): normal rows, then friction;
+ * use_bias selects the solve pass over the relax pass. */
+void solve_constraint(contact_constraint *c, const solve_context *sc, int use_bias);
+/* Applies one manifold's accumulated impulses (warm start). */
+void warm_start_constraint(contact_constraint *c, impulse_body *bodies);
+
+/* Wide passes (solver_wide.c): constraints coloured so that none in a colour
+ * shares a moving body, packed four to a batch. */
+typedef struct wide_set wide_set;
+/* Builds the batches in *mem (grown as needed); NULL on out of memory. */
+wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
+void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies);
+void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias);
+/* Writes the batches' impulses back to the constraints' points. */
+void wide_store(const wide_set *ws, contact_constraint *cc);
+
 /* Coulomb's cone: scales the friction impulse (t1, t2) back to |t| <= limit. */
 static inline void coulomb_clamp(double *t1, double *t2, double limit)
 {

@@ -174,6 +174,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     step_scratch *s = &w->scratch;
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
+    free(s->tight_box); free(s->pose); free(s->touching); free(s->wide);
     free(w);
 }
 
@@ -266,15 +267,17 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     w->stats.toi_events = 0;
 
     double t1 = now_ms();
-    world_update_pairs(w);
+    /* out of memory in a stage stops the step there: later stages read what
+     * the earlier ones produced this step */
+    int ok = world_update_pairs(w);
     double t2 = now_ms();
-    world_collide(w);
+    if (ok) ok = world_collide(w);
     double t3 = now_ms();
-    int ok = world_solve(w, dt);
+    if (ok) ok = world_solve(w, dt);
     double t4 = now_ms();
-    if (w->def.enable_continuous) world_continuous(w, dt);
+    if (ok && w->def.enable_continuous) world_continuous(w, dt);
     double t5 = now_ms();
-    world_update_sleep(w, dt);
+    if (ok) world_update_sleep(w, dt);
     double t6 = now_ms();
 
     w->stats.ms_broadphase = t2 - t1;

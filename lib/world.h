@@ -27,8 +27,15 @@ typedef struct step_scratch {
     int body_capacity;
     void *constraints;          /* solver.c's constraint arrays */
     int constraint_capacity;
+    void *wide;                 /* solver_wide.c's batches */
+    size_t wide_capacity;
     int *island_parent;         /* union-find over id indices */
     int island_capacity;
+    aabb *tight_box;            /* per store slot, awake dynamic/kinematic bodies: this step's bounds */
+    xform *pose;                /* per store slot, same bodies: this step's body frame */
+    int slot_capacity;
+    int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
+    int touching_count, touching_capacity;
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
 } step_scratch;
@@ -63,8 +70,8 @@ int world_push_event(carom_world *w, const carom_contact_event *e);
 carom_body_id world_make_id(const carom_world *w, int id_index);
 
 /* Stages of the step, one file each. */
-void world_update_pairs(carom_world *w);               /* broadphase.c users: collide.c */
-void world_collide(carom_world *w);                    /* narrowphase over contacts */
+int world_update_pairs(carom_world *w);                /* collision.c (0 on out of memory) */
+int world_collide(carom_world *w);                     /* collision.c: narrowphase over contacts (0: out of memory) */
 int world_solve(carom_world *w, double dt);            /* solver.c (0 on out of memory) */
 void world_update_sleep(carom_world *w, double dt);    /* island.c */
 void world_continuous(carom_world *w, double dt);      /* toi.c */

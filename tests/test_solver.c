@@ -504,6 +504,88 @@ static void test_momentum_conserved_in_free_collisions(void **state)
     }
 }
 
+/* The wide passes (four manifolds per batch) against the scalar ones: a row
+ * of N independent experiments on one ground (N manifolds, enough for the
+ * wide path; each shares only the static ground, so the colour order changes
+ * nothing) must follow the lone experiment (solved scalar) to rounding, and
+ * the analytic answer. Boxes slide from 5 m/s (4-point manifolds, friction
+ * rows), spheres roll into 5/7 of 5 m/s, spheres bounce with e = 0.5. */
+enum { ROW_SLIDE, ROW_ROLL, ROW_BOUNCE };
+
+static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
+{
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    if (kind == ROW_BOUNCE) wd.substeps = 8;
+    carom_world *w = world_with(wd, 1, kind == ROW_BOUNCE ? 0.0 : 0.5, 0.0);
+    carom_body_id ids[96];
+    assert_true(n <= 96);
+    for (int i = 0; i < n; i++) {
+        carom_body_def d = carom_body_def_default();
+        double x = 4.0 * (i % 12), y = 4.0 * (i / 12);
+        if (kind == ROW_SLIDE) {
+            d.position = vec(x, y, 0.5);
+            d.shape = carom_shape_box(0.5, 0.5, 0.5);
+            d.friction = 0.5;
+        } else {
+            d.position = vec(x, y, kind == ROW_BOUNCE ? 1.1 : 0.25);
+            d.shape = carom_shape_sphere(kind == ROW_BOUNCE ? 0.1 : 0.25);
+            d.friction = kind == ROW_BOUNCE ? 0.0 : 0.5;
+            d.restitution = kind == ROW_BOUNCE ? 0.5 : 0.0;
+        }
+        if (kind == ROW_ROLL) d.linear_velocity = vec(5, 0, 0);
+        ids[i] = carom_body_create(w, &d);
+        assert_false(carom_body_id_is_null(ids[i]));
+    }
+    if (kind == ROW_SLIDE) {
+        step_n(w, 10, DT);
+        for (int i = 0; i < n; i++) assert_int_equal(carom_body_set_linear_velocity(w, ids[i], vec(5, 0, 0)), CAROM_OK);
+    }
+    int steps = kind == ROW_SLIDE ? 180 : kind == ROW_ROLL ? 120 : 40;
+    int most = 0;
+    for (int s = 0; s < steps; s++) {
+        step_n(w, 1, DT);
+        carom_world_stats st = carom_world_stats_init();
+        assert_int_equal(carom_world_get_stats(w, &st), CAROM_OK);
+        if (st.contacts > most) most = st.contacts;
+    }
+    if (n > 1) assert_true(most >= 64); /* the wide path's threshold */
+    for (int i = 0; i < n; i++) {
+        end_pos[i] = pos(w, ids[i]);
+        end_vel[i] = vel(w, ids[i]);
+        end_pos[i].x -= 4.0 * (i % 12);
+        end_pos[i].y -= 4.0 * (i / 12);
+    }
+    carom_world_destroy(w);
+}
+
+static void test_wide_passes_match_scalar(void **state)
+{
+    (void)state;
+    const int n = 96;
+    carom_vec3 lone_p, lone_v, row_p[96], row_v[96];
+    for (int kind = ROW_SLIDE; kind <= ROW_BOUNCE; kind++) {
+        run_row(kind, 1, &lone_p, &lone_v);
+        run_row(kind, n, row_p, row_v);
+        for (int i = 0; i < n; i++) {
+            double dp = fabs(row_p[i].x - lone_p.x) + fabs(row_p[i].y - lone_p.y) + fabs(row_p[i].z - lone_p.z);
+            double dv = fabs(row_v[i].x - lone_v.x) + fabs(row_v[i].y - lone_v.y) + fabs(row_v[i].z - lone_v.z);
+            if (!(dp < 1e-9 && dv < 1e-9)) {
+                print_error("kind %d body %d: wide differs from scalar by %.3g m, %.3g m/s\n", kind, i, dp, dv);
+                fail();
+            }
+        }
+        if (kind == ROW_SLIDE) EXPECT_NEAR(lone_p.x, 25.0 / (2 * 0.5 * G), 0.03 * 25.0 / (2 * 0.5 * G), "stopping distance");
+        if (kind == ROW_ROLL) EXPECT_NEAR(lone_v.x, 25.0 / 7.0, 0.02 * 25.0 / 7.0, "rolling speed");
+        if (kind == ROW_BOUNCE) {
+            /* 40 steps: past the first bounce, rising (v = 0 at the 0.25 m apex) */
+            assert_true(lone_v.z > 0.0);
+            double apex = lone_p.z - 0.1 + lone_v.z * lone_v.z / (2 * G);
+            EXPECT_NEAR(apex, 0.25, 0.02 * 0.25, "rebound apex");
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -522,6 +604,7 @@ int main(void)
         cmocka_unit_test(test_sleep_and_wake),
         cmocka_unit_test(test_locks),
         cmocka_unit_test(test_momentum_conserved_in_free_collisions),
+        cmocka_unit_test(test_wide_passes_match_scalar),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

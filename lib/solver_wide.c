@@ -1,0 +1,423 @@
+/* solver_wide.c - the warm-start, solve and relax passes over batches of four
+ * independent manifolds. Sequential impulses on one manifold form a chain of
+ * dependent floating-point operations (each row reads the velocity the last
+ * row wrote), so a scalar pass runs at the latency of that chain. Greedy graph
+ * colouring puts manifolds that share no moving body in one colour; within a
+ * colour, manifolds with the same number of points are packed four to a batch,
+ * field by field, and the four chains run side by side. Each manifold is still
+ * solved point by point exactly as in solver.c; only the order between
+ * manifolds becomes colour by colour. Manifolds beyond the last colour keep
+ * the scalar pass. */
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "solver.h"
+
+#define LANES 4
+
+/* Four lanes: a GNU C vector where the compiler has them (SSE2 pairs, or one
+ * AVX register in the AVX2 build of the kernels below), else an array. Both
+ * are indexed as x[lane]. */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__aarch64__))
+#define WIDE_VECTORS 1
+typedef double lane_t __attribute__((vector_size(LANES * sizeof(double))));
+typedef long long lane_mask __attribute__((vector_size(LANES * sizeof(double))));
+#define WIDE_COLORS 32 /* one bit each in a body's mask */
+#if defined(__x86_64__)
+#define WIDE_AVX2 1
+#endif
+#else
+/* no vectors: every manifold takes the scalar passes */
+#define WIDE_VECTORS 0
+#define WIDE_COLORS 1
+typedef double lane_t[LANES];
+#endif
+#ifndef WIDE_AVX2
+#define WIDE_AVX2 0
+#endif
+
+/* One point slot of a batch: lane l holds point i of the batch's l-th manifold. */
+typedef struct wide_point {
+    lane_t base_separation, normal_mass, normal_impulse;
+    lane_t total_normal_impulse, max_normal_impulse;
+    lane_t ra_n[3], rb_n[3], ia_n[3], ib_n[3];
+    lane_t tangent_mass[2], tangent_impulse[2];
+    lane_t ra_t[2][3], rb_t[2][3], ia_t[2][3], ib_t[2][3];
+} wide_point;
+
+typedef struct wide_batch {
+    lane_t n[3], t1[3], t2[3];
+    lane_t friction, bias_rate, mass_scale, impulse_scale;
+    int a[LANES], b[LANES];      /* solver bodies; an empty lane uses the static body 0 */
+    int con[LANES];              /* constraint index per lane */
+    int count;                   /* points per manifold, the same in every lane */
+    int lanes;                   /* lanes in use */
+    int first;                   /* first of `count` wide points */
+} wide_batch;
+
+struct wide_set {
+    wide_batch *batches;
+    wide_point *points;
+    int *overflow;               /* constraints with no colour: scalar passes */
+    int batch_count, overflow_count;
+    int avx2;                    /* run the AVX2 build of the passes */
+};
+
+static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
+
+static void fill_lane(wide_batch *wb, wide_point *wp, int l, int ci, const contact_constraint *c)
+{
+    wb->a[l] = c->a;
+    wb->b[l] = c->b;
+    wb->con[l] = ci;
+    for (int d = 0; d < 3; d++) {
+        wb->n[d][l] = v3_get(c->n, d);
+        wb->t1[d][l] = v3_get(c->t1, d);
+        wb->t2[d][l] = v3_get(c->t2, d);
+    }
+    wb->friction[l] = c->friction;
+    wb->bias_rate[l] = c->soft.bias_rate;
+    wb->mass_scale[l] = c->soft.mass_scale;
+    wb->impulse_scale[l] = c->soft.impulse_scale;
+    for (int i = 0; i < c->count; i++) {
+        const constraint_point *p = &c->p[i];
+        wide_point *q = &wp[i];
+        q->base_separation[l] = p->base_separation;
+        q->normal_mass[l] = p->normal_mass;
+        q->normal_impulse[l] = p->normal_impulse;
+        q->total_normal_impulse[l] = p->total_normal_impulse;
+        q->max_normal_impulse[l] = p->max_normal_impulse;
+        for (int d = 0; d < 3; d++) {
+            q->ra_n[d][l] = v3_get(p->ra_n, d);
+            q->rb_n[d][l] = v3_get(p->rb_n, d);
+            q->ia_n[d][l] = v3_get(p->ia_n, d);
+            q->ib_n[d][l] = v3_get(p->ib_n, d);
+            for (int k = 0; k < 2; k++) {
+                q->ra_t[k][d][l] = v3_get(p->ra_t[k], d);
+                q->rb_t[k][d][l] = v3_get(p->rb_t[k], d);
+                q->ia_t[k][d][l] = v3_get(p->ia_t[k], d);
+                q->ib_t[k][d][l] = v3_get(p->ib_t[k], d);
+            }
+        }
+        for (int k = 0; k < 2; k++) {
+            q->tangent_mass[k][l] = p->tangent_mass[k];
+            q->tangent_impulse[k][l] = p->tangent_impulse[k];
+        }
+    }
+}
+
+wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
+{
+    /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
+    int max_batches = ncon / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
+    int npoints = 0;
+    for (int k = 0; k < ncon; k++) npoints += cc[k].count;
+    int max_wide_points = npoints / LANES + WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
+    size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
+                   align_up(sizeof(wide_point) * (size_t)max_wide_points) + align_up(sizeof(int) * (size_t)ncon) * 2 +
+                   align_up(sizeof(uint32_t) * (size_t)nb);
+    if (bytes > *capacity) {
+        size_t cap = *capacity ? *capacity : 4096;
+        while (cap < bytes) cap *= 2;
+        void *p = realloc(*mem, cap + 63);
+        if (!p) return NULL;
+        *mem = p;
+        *capacity = cap;
+    }
+    char *base = (char *)(((uintptr_t)*mem + 63) & ~(uintptr_t)63);
+    wide_set *ws = (wide_set *)base;
+    base += align_up(sizeof *ws);
+    ws->batches = (wide_batch *)base;
+    base += align_up(sizeof(wide_batch) * (size_t)max_batches);
+    ws->points = (wide_point *)base;
+    base += align_up(sizeof(wide_point) * (size_t)max_wide_points);
+    ws->overflow = (int *)base;
+    base += align_up(sizeof(int) * (size_t)ncon);
+    int *color = (int *)base;
+    base += align_up(sizeof(int) * (size_t)ncon);
+    uint32_t *used = (uint32_t *)base;
+    memset(used, 0, sizeof *used * (size_t)nb);
+
+    /* greedy colouring; the static body 0 never blocks (it does not move) */
+    int bucket[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+    memset(bucket, 0, sizeof bucket);
+    ws->overflow_count = 0;
+    for (int k = 0; k < ncon; k++) {
+        int a = cc[k].a, b = cc[k].b;
+        uint32_t taken = (a ? used[a] : 0) | (b ? used[b] : 0);
+        int c = 0;
+        while (c < WIDE_COLORS && (taken >> c & 1u)) c++;
+        if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1) {
+            color[k] = -1;
+            ws->overflow[ws->overflow_count++] = k;
+            continue;
+        }
+        color[k] = c;
+        if (a) used[a] |= 1u << c;
+        if (b) used[b] |= 1u << c;
+        bucket[c][cc[k].count]++;
+    }
+    /* batches in colour order; inside a colour, by point count */
+    int start[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+    int nbatch = 0, nwide = 0;
+    for (int c = 0; c < WIDE_COLORS; c++)
+        for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
+            start[c][n] = nbatch;
+            int batches = (bucket[c][n] + LANES - 1) / LANES;
+            for (int i = 0; i < batches; i++) {
+                wide_batch *wb = &ws->batches[nbatch + i];
+                memset(wb, 0, sizeof *wb);
+                wb->count = n;
+                wb->first = nwide + i * n;
+                memset(&ws->points[wb->first], 0, sizeof(wide_point) * (size_t)n);
+            }
+            nbatch += batches;
+            nwide += batches * n;
+            bucket[c][n] = 0; /* now: lanes filled so far */
+        }
+    for (int k = 0; k < ncon; k++) {
+        int c = color[k];
+        if (c < 0) continue;
+        int n = cc[k].count, slot = bucket[c][n]++;
+        wide_batch *wb = &ws->batches[start[c][n] + slot / LANES];
+        fill_lane(wb, &ws->points[wb->first], slot % LANES, k, &cc[k]);
+        wb->lanes = slot % LANES + 1;
+    }
+    ws->batch_count = nbatch;
+#if WIDE_AVX2
+    ws->avx2 = __builtin_cpu_supports("avx2") != 0;
+#else
+    ws->avx2 = 0;
+#endif
+    return ws;
+}
+
+#if WIDE_VECTORS
+/* Lane helpers are macros: a function taking or returning a 32-byte vector
+ * would draw GCC's note on the AVX calling convention. Arguments are plain
+ * variables (each is evaluated twice). */
+#define LANE_INLINE static inline __attribute__((always_inline)) /* also into the AVX2 copies below */
+#define SPLAT(x) ((lane_t){(x), (x), (x), (x)})
+#define SELECT_LANES(m, a, b) ((lane_t)(((m) & (lane_mask)(a)) | (~(m) & (lane_mask)(b))))
+#define LANE_MAX(a, b) SELECT_LANES((a) > (b), a, b)
+#define LANE_MIN(a, b) SELECT_LANES((a) < (b), a, b)
+#define DOT3(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+
+/* The lanes' body velocities, gathered and scattered around each batch. */
+typedef struct lane_bodies {
+    lane_t va[3], wa[3], vb[3], wb[3];
+    lane_t ma, mb;
+} lane_bodies;
+
+LANE_INLINE void gather(const wide_batch *wb, const impulse_body *bodies, lane_bodies *lb)
+{
+    for (int l = 0; l < LANES; l++) {
+        const impulse_body *A = &bodies[wb->a[l]], *B = &bodies[wb->b[l]];
+        lb->va[0][l] = A->v.x; lb->va[1][l] = A->v.y; lb->va[2][l] = A->v.z;
+        lb->wa[0][l] = A->w.x; lb->wa[1][l] = A->w.y; lb->wa[2][l] = A->w.z;
+        lb->vb[0][l] = B->v.x; lb->vb[1][l] = B->v.y; lb->vb[2][l] = B->v.z;
+        lb->wb[0][l] = B->w.x; lb->wb[1][l] = B->w.y; lb->wb[2][l] = B->w.z;
+        lb->ma[l] = A->inv_mass;
+        lb->mb[l] = B->inv_mass;
+    }
+}
+
+LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_bodies *lb)
+{
+    /* empty lanes write the static body back unchanged: zero plus zero */
+    for (int l = 0; l < LANES; l++) {
+        impulse_body *A = &bodies[wb->a[l]], *B = &bodies[wb->b[l]];
+        A->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
+        A->w = v3(lb->wa[0][l], lb->wa[1][l], lb->wa[2][l]);
+        B->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
+        B->w = v3(lb->wb[0][l], lb->wb[1][l], lb->wb[2][l]);
+    }
+}
+
+LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body *bodies)
+{
+    lane_bodies lb;
+    gather(wb, bodies, &lb);
+    for (int i = 0; i < wb->count; i++) {
+        wide_point *p = &pts[i];
+        lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
+        p->total_normal_impulse += ni;
+        for (int d = 0; d < 3; d++) {
+            lane_t P = wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2;
+            lb.va[d] -= lb.ma * P;
+            lb.vb[d] += lb.mb * P;
+            lb.wa[d] -= p->ia_n[d] * ni + p->ia_t[0][d] * t1 + p->ia_t[1][d] * t2;
+            lb.wb[d] += p->ib_n[d] * ni + p->ib_t[0][d] * t1 + p->ib_t[1][d] * t2;
+        }
+    }
+    scatter(wb, bodies, &lb);
+}
+
+/* The scalar solve_constraint (solver.c), four manifolds at a time. */
+LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_context *sc, int use_bias)
+{
+    lane_bodies lb;
+    gather(wb, sc->bodies, &lb);
+    lane_t dp[3], dqa[3], dqb[3];
+    for (int l = 0; l < LANES; l++) {
+        vec3 pa = sc->dp[wb->a[l]], pb = sc->dp[wb->b[l]], qa = sc->dq[wb->a[l]], qb = sc->dq[wb->b[l]];
+        dp[0][l] = pb.x - pa.x; dp[1][l] = pb.y - pa.y; dp[2][l] = pb.z - pa.z;
+        dqa[0][l] = qa.x; dqa[1][l] = qa.y; dqa[2][l] = qa.z;
+        dqb[0][l] = qb.x; dqb[1][l] = qb.y; dqb[2][l] = qb.z;
+    }
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(sc->inv_h), push = SPLAT(-sc->push_max);
+    /* bias, mass and impulse scales of a penetrating point (speculative ones differ per lane below) */
+    lane_t pen_mass_scale = one, pen_impulse_scale = zero;
+    int soft = use_bias && sc->correction == CAROM_CORRECTION_SOFT;
+    int baumgarte = use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE;
+    if (soft) {
+        pen_mass_scale = wb->mass_scale;
+        pen_impulse_scale = wb->impulse_scale;
+    }
+    const lane_t baum_rate = SPLAT(sc->baumgarte * sc->inv_h), slop = SPLAT(sc->slop);
+    for (int i = 0; i < wb->count; i++) {
+        wide_point *p = &pts[i];
+        /* current separation: small-angle update of the anchors */
+        lane_t s = p->base_separation + DOT3(wb->n, dp) + DOT3(dqb, p->rb_n) - DOT3(dqa, p->ra_n);
+        lane_t pen_bias = zero;
+        if (soft) {
+            lane_t b = wb->bias_rate * s;
+            pen_bias = LANE_MAX(b, push);
+        } else if (baumgarte) {
+            lane_t e = s + slop;
+            lane_t b = baum_rate * LANE_MIN(e, zero);
+            pen_bias = LANE_MAX(b, push);
+        }
+        /* speculative (s > 0): arrive exactly at contact, rigidly */
+        lane_mask ahead = s > zero;
+        lane_t bias = SELECT_LANES(ahead, s * inv_h, pen_bias);
+        lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
+        lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
+        lane_t vn = wb->n[0] * (lb.vb[0] - lb.va[0]) + wb->n[1] * (lb.vb[1] - lb.va[1]) + wb->n[2] * (lb.vb[2] - lb.va[2]) +
+                    DOT3(lb.wb, p->rb_n) - DOT3(lb.wa, p->ra_n);
+        lane_t old = p->normal_impulse;
+        lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
+        total = LANE_MAX(total, zero);
+        lane_t lambda = total - old;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        lane_t most = p->max_normal_impulse;
+        p->max_normal_impulse = LANE_MAX(most, total);
+        lane_t la = lb.ma * lambda, lbm = lb.mb * lambda;
+        for (int d = 0; d < 3; d++) {
+            lb.va[d] -= la * wb->n[d];
+            lb.wa[d] -= lambda * p->ia_n[d];
+            lb.vb[d] += lbm * wb->n[d];
+            lb.wb[d] += lambda * p->ib_n[d];
+        }
+    }
+    if (sc->friction) {
+        for (int i = 0; i < wb->count; i++) {
+            wide_point *p = &pts[i];
+            lane_t dv[3] = {lb.vb[0] - lb.va[0], lb.vb[1] - lb.va[1], lb.vb[2] - lb.va[2]};
+            lane_t v1 = DOT3(dv, wb->t1) + DOT3(lb.wb, p->rb_t[0]) - DOT3(lb.wa, p->ra_t[0]);
+            lane_t v2 = DOT3(dv, wb->t2) + DOT3(lb.wb, p->rb_t[1]) - DOT3(lb.wa, p->ra_t[1]);
+            lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+            lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
+            /* Coulomb's cone, as coulomb_clamp: scale back to |t| <= mu * normal */
+            lane_t limit = wb->friction * p->normal_impulse;
+            lane_t mag2 = n1 * n1 + n2 * n2;
+            lane_mask over = mag2 > limit * limit;
+            lane_t f = one;
+            for (int l = 0; l < LANES; l++)
+                if (over[l]) f[l] = limit[l] / sqrt(mag2[l]);
+            n1 *= f;
+            n2 *= f;
+            p->tangent_impulse[0] = n1;
+            p->tangent_impulse[1] = n2;
+            lane_t d1 = n1 - o1, d2 = n2 - o2;
+            for (int d = 0; d < 3; d++) {
+                lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
+                lb.va[d] -= lb.ma * P;
+                lb.vb[d] += lb.mb * P;
+                lb.wa[d] -= p->ia_t[0][d] * d1 + p->ia_t[1][d] * d2;
+                lb.wb[d] += p->ib_t[0][d] * d1 + p->ib_t[1][d] * d2;
+            }
+        }
+    }
+    scatter(wb, sc->bodies, &lb);
+}
+
+static void warm_batches(wide_set *ws, impulse_body *bodies)
+{
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        warm_batch(wb, &ws->points[wb->first], bodies);
+    }
+}
+
+static void solve_batches(wide_set *ws, const solve_context *sc, int use_bias)
+{
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        solve_batch(wb, &ws->points[wb->first], sc, use_bias);
+    }
+}
+
+#if WIDE_AVX2
+/* The same passes compiled for AVX2 (one register per four lanes instead of
+ * two, and twice the registers), chosen at run time. No FMA: rounding stays
+ * the same as the SSE2 build, so results do not depend on the machine. */
+__attribute__((target("avx2"))) static void warm_batches_avx2(wide_set *ws, impulse_body *bodies)
+{
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        warm_batch(wb, &ws->points[wb->first], bodies);
+    }
+}
+
+__attribute__((target("avx2"))) static void solve_batches_avx2(wide_set *ws, const solve_context *sc, int use_bias)
+{
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        solve_batch(wb, &ws->points[wb->first], sc, use_bias);
+    }
+}
+#endif
+#endif
+
+void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies)
+{
+#if WIDE_AVX2
+    if (ws->avx2) warm_batches_avx2(ws, bodies);
+    else warm_batches(ws, bodies);
+#elif WIDE_VECTORS
+    warm_batches(ws, bodies);
+#endif
+    for (int k = 0; k < ws->overflow_count; k++) warm_start_constraint(&cc[ws->overflow[k]], bodies);
+}
+
+void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias)
+{
+#if WIDE_AVX2
+    if (ws->avx2) solve_batches_avx2(ws, sc, use_bias);
+    else solve_batches(ws, sc, use_bias);
+#elif WIDE_VECTORS
+    solve_batches(ws, sc, use_bias);
+#endif
+    for (int k = 0; k < ws->overflow_count; k++) solve_constraint(&cc[ws->overflow[k]], sc, use_bias);
+}
+
+void wide_store(const wide_set *ws, contact_constraint *cc)
+{
+    for (int k = 0; k < ws->batch_count; k++) {
+        const wide_batch *wb = &ws->batches[k];
+        for (int l = 0; l < wb->lanes; l++) {
+            contact_constraint *c = &cc[wb->con[l]];
+            for (int i = 0; i < wb->count; i++) {
+                const wide_point *q = &ws->points[wb->first + i];
+                constraint_point *p = &c->p[i];
+                p->normal_impulse = q->normal_impulse[l];
+                p->total_normal_impulse = q->total_normal_impulse[l];
+                p->max_normal_impulse = q->max_normal_impulse[l];
+                p->tangent_impulse[0] = q->tangent_impulse[0][l];
+                p->tangent_impulse[1] = q->tangent_impulse[1][l];
+            }
+        }
+    }
+}
