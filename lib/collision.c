@@ -122,7 +122,7 @@ int world_collide(carom_world *w)
             memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
             collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
             if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
-        } else {
+        } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
             c->m.count = 0;
         }
         int touching = c->m.count > 0;

@@ -520,7 +520,7 @@ int world_solve(carom_world *w, double dt)
             ct->state[j].max_normal_impulse = p->max_normal_impulse;
             ct->state[j].relative_velocity = p->relative_velocity;
             total += p->total_normal_impulse;
-            tangent += hypot(p->tangent_impulse[0], p->tangent_impulse[1]) * substeps;
+            tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;
             if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
         }
         if (approach > def->restitution_threshold && total > 0.0) {

@@ -166,10 +166,14 @@ wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int n
             int batches = (bucket[c][n] + LANES - 1) / LANES;
             for (int i = 0; i < batches; i++) {
                 wide_batch *wb = &ws->batches[nbatch + i];
-                memset(wb, 0, sizeof *wb);
+                int first = nwide + i * n;
+                if (i == batches - 1 && bucket[c][n] % LANES) {
+                    /* the part-full batch: empty lanes stay zero (no mass, no effect) */
+                    memset(wb, 0, sizeof *wb);
+                    memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
+                }
                 wb->count = n;
-                wb->first = nwide + i * n;
-                memset(&ws->points[wb->first], 0, sizeof(wide_point) * (size_t)n);
+                wb->first = first;
             }
             nbatch += batches;
             nwide += batches * n;
