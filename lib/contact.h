@@ -16,9 +16,6 @@ enum {
 typedef struct contact_point_state {
     double normal_impulse;      /* accumulated (per sub-step), for warm starting */
     double tangent_impulse[2];
-    double total_normal_impulse;   /* everything applied over the step */
-    double max_normal_impulse;
-    double relative_velocity;   /* normal velocity before solving (restitution) */
     vec3 local_a;               /* point in A's body frame (fallback matching) */
 } contact_point_state;
 

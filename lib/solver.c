@@ -516,9 +516,6 @@ int world_solve(carom_world *w, double dt)
             ct->state[j].normal_impulse = p->normal_impulse;
             ct->state[j].tangent_impulse[0] = p->tangent_impulse[0];
             ct->state[j].tangent_impulse[1] = p->tangent_impulse[1];
-            ct->state[j].total_normal_impulse = p->total_normal_impulse;
-            ct->state[j].max_normal_impulse = p->max_normal_impulse;
-            ct->state[j].relative_velocity = p->relative_velocity;
             total += p->total_normal_impulse;
             tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;
             if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }

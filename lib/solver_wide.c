@@ -327,11 +327,13 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
             lane_t limit = wb->friction * p->normal_impulse;
             lane_t mag2 = n1 * n1 + n2 * n2;
             lane_mask over = mag2 > limit * limit;
-            lane_t f = one;
-            for (int l = 0; l < LANES; l++)
-                if (over[l]) f[l] = limit[l] / sqrt(mag2[l]);
-            n1 *= f;
-            n2 *= f;
+            if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
+                lane_t f = one;
+                for (int l = 0; l < LANES; l++)
+                    if (over[l]) f[l] = limit[l] / sqrt(mag2[l]);
+                n1 *= f;
+                n2 *= f;
+            }
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
             lane_t d1 = n1 - o1, d2 = n2 - o2;
