@@ -116,12 +116,19 @@ int world_collide(carom_world *w)
         aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
         if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
             xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-            manifold old_m = c->m;
-            contact_point_state old_state[MANIFOLD_MAX_POINTS];
-            /* only the live entries: most pairs near contact have none */
-            memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
-            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
-            if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
+            if (c->m.count == 0) {
+                /* most pairs near contact: nothing to carry over, nothing to copy */
+                manifold none;
+                none.count = 0;
+                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
+                if (c->m.count > 0) contact_match_points(c, &none, c->state, xa);
+            } else {
+                manifold old_m = c->m;
+                contact_point_state old_state[MANIFOLD_MAX_POINTS];
+                memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
+                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
+                if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
+            }
         } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
             c->m.count = 0;
         }

@@ -228,13 +228,19 @@ LANE_INLINE void gather(const wide_batch *wb, const impulse_body *bodies, lane_b
 
 LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_bodies *lb)
 {
-    /* empty lanes write the static body back unchanged: zero plus zero */
+    /* never the static body 0 (it does not move): a store to it would make the
+     * next batch's gather wait for this batch to finish */
     for (int l = 0; l < LANES; l++) {
-        impulse_body *A = &bodies[wb->a[l]], *B = &bodies[wb->b[l]];
-        A->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
-        A->w = v3(lb->wa[0][l], lb->wa[1][l], lb->wa[2][l]);
-        B->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
-        B->w = v3(lb->wb[0][l], lb->wb[1][l], lb->wb[2][l]);
+        if (wb->a[l]) {
+            impulse_body *A = &bodies[wb->a[l]];
+            A->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
+            A->w = v3(lb->wa[0][l], lb->wa[1][l], lb->wa[2][l]);
+        }
+        if (wb->b[l]) {
+            impulse_body *B = &bodies[wb->b[l]];
+            B->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
+            B->w = v3(lb->wb[0][l], lb->wb[1][l], lb->wb[2][l]);
+        }
     }
 }
 
