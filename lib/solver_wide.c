@@ -206,6 +206,11 @@ wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int n
 #define LANE_MAX(a, b) SELECT_LANES((a) > (b), a, b)
 #define LANE_MIN(a, b) SELECT_LANES((a) < (b), a, b)
 #define DOT3(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+#define SET_LANES(dst, P0, P1, P2, P3, field)                                    \
+    do {                                                                         \
+        const double lanes_[LANES] = {(P0)->field, (P1)->field, (P2)->field, (P3)->field}; \
+        memcpy(&(dst), lanes_, sizeof(dst));                                     \
+    } while (0)
 
 /* The lanes' body velocities, gathered and scattered around each batch. */
 typedef struct lane_bodies {
@@ -215,15 +220,24 @@ typedef struct lane_bodies {
 
 LANE_INLINE void gather(const wide_batch *wb, const impulse_body *bodies, lane_bodies *lb)
 {
-    for (int l = 0; l < LANES; l++) {
-        const impulse_body *A = &bodies[wb->a[l]], *B = &bodies[wb->b[l]];
-        lb->va[0][l] = A->v.x; lb->va[1][l] = A->v.y; lb->va[2][l] = A->v.z;
-        lb->wa[0][l] = A->w.x; lb->wa[1][l] = A->w.y; lb->wa[2][l] = A->w.z;
-        lb->vb[0][l] = B->v.x; lb->vb[1][l] = B->v.y; lb->vb[2][l] = B->v.z;
-        lb->wb[0][l] = B->w.x; lb->wb[1][l] = B->w.y; lb->wb[2][l] = B->w.z;
-        lb->ma[l] = A->inv_mass;
-        lb->mb[l] = B->inv_mass;
-    }
+    /* whole vectors from their four lanes through memcpy (element inserts, or
+     * a braced vector, draw GCC's maybe-uninitialized false positive) */
+    const impulse_body *A0 = &bodies[wb->a[0]], *A1 = &bodies[wb->a[1]], *A2 = &bodies[wb->a[2]], *A3 = &bodies[wb->a[3]];
+    const impulse_body *B0 = &bodies[wb->b[0]], *B1 = &bodies[wb->b[1]], *B2 = &bodies[wb->b[2]], *B3 = &bodies[wb->b[3]];
+    SET_LANES(lb->va[0], A0, A1, A2, A3, v.x);
+    SET_LANES(lb->va[1], A0, A1, A2, A3, v.y);
+    SET_LANES(lb->va[2], A0, A1, A2, A3, v.z);
+    SET_LANES(lb->wa[0], A0, A1, A2, A3, w.x);
+    SET_LANES(lb->wa[1], A0, A1, A2, A3, w.y);
+    SET_LANES(lb->wa[2], A0, A1, A2, A3, w.z);
+    SET_LANES(lb->vb[0], B0, B1, B2, B3, v.x);
+    SET_LANES(lb->vb[1], B0, B1, B2, B3, v.y);
+    SET_LANES(lb->vb[2], B0, B1, B2, B3, v.z);
+    SET_LANES(lb->wb[0], B0, B1, B2, B3, w.x);
+    SET_LANES(lb->wb[1], B0, B1, B2, B3, w.y);
+    SET_LANES(lb->wb[2], B0, B1, B2, B3, w.z);
+    SET_LANES(lb->ma, A0, A1, A2, A3, inv_mass);
+    SET_LANES(lb->mb, B0, B1, B2, B3, inv_mass);
 }
 
 LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_bodies *lb)
@@ -268,13 +282,24 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
 {
     lane_bodies lb;
     gather(wb, sc->bodies, &lb);
-    lane_t dp[3], dqa[3], dqb[3];
-    for (int l = 0; l < LANES; l++) {
-        vec3 pa = sc->dp[wb->a[l]], pb = sc->dp[wb->b[l]], qa = sc->dq[wb->a[l]], qb = sc->dq[wb->b[l]];
-        dp[0][l] = pb.x - pa.x; dp[1][l] = pb.y - pa.y; dp[2][l] = pb.z - pa.z;
-        dqa[0][l] = qa.x; dqa[1][l] = qa.y; dqa[2][l] = qa.z;
-        dqb[0][l] = qb.x; dqb[1][l] = qb.y; dqb[2][l] = qb.z;
-    }
+    const vec3 *pa0 = &sc->dp[wb->a[0]], *pa1 = &sc->dp[wb->a[1]], *pa2 = &sc->dp[wb->a[2]], *pa3 = &sc->dp[wb->a[3]];
+    const vec3 *pb0 = &sc->dp[wb->b[0]], *pb1 = &sc->dp[wb->b[1]], *pb2 = &sc->dp[wb->b[2]], *pb3 = &sc->dp[wb->b[3]];
+    const vec3 *qa0 = &sc->dq[wb->a[0]], *qa1 = &sc->dq[wb->a[1]], *qa2 = &sc->dq[wb->a[2]], *qa3 = &sc->dq[wb->a[3]];
+    const vec3 *qb0 = &sc->dq[wb->b[0]], *qb1 = &sc->dq[wb->b[1]], *qb2 = &sc->dq[wb->b[2]], *qb3 = &sc->dq[wb->b[3]];
+    lane_t dpa[3], dp[3], dqa[3], dqb[3];
+    SET_LANES(dpa[0], pa0, pa1, pa2, pa3, x);
+    SET_LANES(dpa[1], pa0, pa1, pa2, pa3, y);
+    SET_LANES(dpa[2], pa0, pa1, pa2, pa3, z);
+    SET_LANES(dp[0], pb0, pb1, pb2, pb3, x);
+    SET_LANES(dp[1], pb0, pb1, pb2, pb3, y);
+    SET_LANES(dp[2], pb0, pb1, pb2, pb3, z);
+    for (int d = 0; d < 3; d++) dp[d] -= dpa[d];
+    SET_LANES(dqa[0], qa0, qa1, qa2, qa3, x);
+    SET_LANES(dqa[1], qa0, qa1, qa2, qa3, y);
+    SET_LANES(dqa[2], qa0, qa1, qa2, qa3, z);
+    SET_LANES(dqb[0], qb0, qb1, qb2, qb3, x);
+    SET_LANES(dqb[1], qb0, qb1, qb2, qb3, y);
+    SET_LANES(dqb[2], qb0, qb1, qb2, qb3, z);
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(sc->inv_h), push = SPLAT(-sc->push_max);
     /* bias, mass and impulse scales of a penetrating point (speculative ones differ per lane below) */
     lane_t pen_mass_scale = one, pen_impulse_scale = zero;
