@@ -100,9 +100,9 @@ int main(int argc, char **argv)
                 run_point(scene, &k, heavy ? 1 : runs);
             }
         /* one knob at a time around the default */
-        knobs one[12];
+        knobs one[16];
         int n = 0;
-        for (int i = 0; i < 12; i++) one[i].def = base;
+        for (int i = 0; i < (int)(sizeof one / sizeof one[0]); i++) one[i].def = base;
         one[n].knob = "relax"; one[n].value = "off"; one[n++].def.relax_iterations = 0;
         one[n].knob = "correction"; one[n].value = "baumgarte"; one[n++].def.position_correction = CAROM_CORRECTION_BAUMGARTE;
         one[n].knob = "correction"; one[n].value = "none"; one[n++].def.position_correction = CAROM_CORRECTION_NONE;
@@ -116,6 +116,8 @@ int main(int argc, char **argv)
         one[n].knob = "preset"; one[n].value = "fast"; carom_world_def_apply_preset(&one[n++].def, "fast");
         one[n].knob = "preset"; one[n].value = "accurate"; carom_world_def_apply_preset(&one[n++].def, "accurate");
         one[n].knob = "sleep"; one[n].value = "on"; one[n++].def.enable_sleep = 1;
+        one[n].knob = "reuse"; one[n].value = "0"; one[n++].def.contact_reuse_distance = 0.0;
+        one[n].knob = "reuse"; one[n].value = "1mm"; one[n++].def.contact_reuse_distance = 1e-3;
         for (int i = 0; i < n; i++) run_point(scene, &one[i], heavy ? 1 : runs);
     }
     return 0;

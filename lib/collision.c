@@ -72,6 +72,51 @@ static void push_touch_event(carom_world *w, const contact *c, carom_event_type 
     world_push_event(w, &e);
 }
 
+/* B's frame expressed in A's. */
+static xform relative_pose(xform xa, xform xb)
+{
+    xform r = {xf_inv_point(xa, xb.p), q_mul(q_conj(xa.q), xb.q)};
+    return r;
+}
+
+/* Keeps last manifold when B's material at every contact point has moved less
+ * than `reuse` relative to A since the manifold was computed (a resting pair
+ * moves micrometres a step): each separation changes by the normal component
+ * of that motion, exact to first order, the point by half of it. Returns 1
+ * when the manifold was kept. */
+static int reuse_manifold(contact *c, xform xa, xform xb, double reuse)
+{
+    if (!(c->flags & CONTACT_REUSABLE) || c->m.count == 0 || !(reuse > 0)) return 0;
+    xform now = relative_pose(xa, xb);
+    if (v3_len2(v3_sub(now.p, c->rel_pose.p)) > reuse * reuse) return 0;
+    vec3 moved[MANIFOLD_MAX_POINTS];
+    for (int i = 0; i < c->m.count; i++) {
+        vec3 then = c->state[i].local_a;
+        vec3 in_b = xf_inv_point(c->rel_pose, then); /* B's material there, in B's frame */
+        moved[i] = v3_sub(xf_point(now, in_b), then);
+        if (!(v3_len2(moved[i]) <= reuse * reuse)) return 0;
+    }
+    c->m.normal = q_rotate(xa.q, c->normal_a);
+    for (int i = 0; i < c->m.count; i++) {
+        c->m.points[i].separation = c->state[i].separation + v3_dot(c->normal_a, moved[i]);
+        c->m.points[i].point = xf_point(xa, v3_madd(c->state[i].local_a, 0.5, moved[i]));
+    }
+    return 1;
+}
+
+/* Records the pose a freshly computed manifold belongs to (see reuse_manifold). */
+static void remember_pose(contact *c, xform xa, xform xb)
+{
+    if (c->m.count == 0) {
+        c->flags &= ~(uint32_t)CONTACT_REUSABLE;
+        return;
+    }
+    c->rel_pose = relative_pose(xa, xb);
+    c->normal_a = q_inv_rotate(xa.q, c->m.normal);
+    for (int i = 0; i < c->m.count; i++) c->state[i].separation = c->m.points[i].separation;
+    c->flags |= CONTACT_REUSABLE;
+}
+
 /* Wakes a sleeping body during the collision stage; its later pairs read
  * this step's frame and bounds like every awake body's. */
 static void wake_for_step(carom_world *w, int slot)
@@ -90,6 +135,9 @@ int world_collide(carom_world *w)
     double speculative = w->def.speculative_distance;
     double dt = w->last_dt;
     step_scratch *sc = &w->scratch;
+    /* within the look-ahead, a feature not yet in a manifold cannot reach
+     * contact while the manifold is kept */
+    double reuse = dmin(w->def.contact_reuse_distance, speculative);
     sc->touching_count = 0;
     /* at most every contact is touching: reserve once, so nothing below can fail */
     if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
@@ -116,18 +164,22 @@ int world_collide(carom_world *w)
         aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
         if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
             xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-            if (c->m.count == 0) {
+            if (reuse_manifold(c, xa, xb, reuse)) {
+                /* kept: ids, impulses and feature cache stay as they were */
+            } else if (c->m.count == 0) {
                 /* most pairs near contact: nothing to carry over, nothing to copy */
                 manifold none;
                 none.count = 0;
                 collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
                 if (c->m.count > 0) contact_match_points(c, &none, c->state, xa);
+                remember_pose(c, xa, xb);
             } else {
                 manifold old_m = c->m;
                 contact_point_state old_state[MANIFOLD_MAX_POINTS];
                 memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
                 collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
                 if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
+                remember_pose(c, xa, xb);
             }
         } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
             c->m.count = 0;

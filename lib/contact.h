@@ -10,13 +10,15 @@
 enum {
     CONTACT_TOUCHING     = 1u << 0,   /* manifold has points this step */
     CONTACT_WAS_TOUCHING = 1u << 1,
-    CONTACT_SIM          = 1u << 2    /* solved this step (both bodies not asleep) */
+    CONTACT_SIM          = 1u << 2,   /* solved this step (both bodies not asleep) */
+    CONTACT_REUSABLE     = 1u << 3    /* rel_pose and the points' local_a/separation are valid */
 };
 
 typedef struct contact_point_state {
     double normal_impulse;      /* accumulated (per sub-step), for warm starting */
     double tangent_impulse[2];
-    vec3 local_a;               /* point in A's body frame (fallback matching) */
+    vec3 local_a;               /* point in A's body frame when the manifold was computed */
+    double separation;          /* its separation then (a reused manifold updates from it) */               /* point in A's body frame (fallback matching) */
 } contact_point_state;
 
 typedef struct contact {
@@ -27,6 +29,8 @@ typedef struct contact {
     manifold m;
     contact_point_state state[MANIFOLD_MAX_POINTS];
     vec3 tangent1;              /* friction basis kept across steps */
+    xform rel_pose;             /* B's frame in A's when the manifold was computed */
+    vec3 normal_a;              /* the manifold normal in A's frame then */
 } contact;
 
 /* Open-addressing map from an ordered pair of id indices to a contact index. */

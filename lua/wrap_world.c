@@ -39,6 +39,7 @@ static const world_field world_fields[] = {
     FIELD("baumgarte", baumgarte, 'n'),
     FIELD("linear_slop", linear_slop, 'n'),
     FIELD("speculative_distance", speculative_distance, 'n'),
+    FIELD("reuse_distance", contact_reuse_distance, 'n'),
     FIELD("penalty_stiffness", penalty_stiffness, 'n'),
     FIELD("penalty_damping", penalty_damping, 'n'),
     FIELD("penalty_implicit", penalty_implicit, 'b'),
@@ -60,7 +61,7 @@ static const char *const world_keys[] = {
     "gravity", "preset", "contact_model", "position_correction", "dt", "max_steps",
     "substeps", "iterations", "relax_iterations", "warm_starting", "restitution_threshold", "hertz",
     "damping_ratio", "push_velocity", "baumgarte", "linear_slop", "speculative_distance",
-    "penalty_stiffness", "penalty_damping", "penalty_implicit", "shock_propagation", "friction",
+    "reuse_distance", "penalty_stiffness", "penalty_damping", "penalty_implicit", "shock_propagation", "friction",
     "restitution", "sleep", "ccd", "sleep_time", "sleep_linear_velocity", "sleep_angular_velocity",
     "max_linear_speed", "max_angular_speed", "body_capacity", NULL};
 

@@ -131,6 +131,11 @@ typedef struct carom_world_def {
     int body_capacity;                  /* 0: initial storage hint */
     carom_event_fn *event_callback;     /* NULL: events are only buffered */
     void *event_context;
+    double contact_reuse_distance;      /* 1e-4 m: a touching pair whose material at every
+                                           contact point moved less than this relative to the
+                                           other body since its manifold was computed keeps it
+                                           (separations updated to first order); capped at
+                                           speculative_distance; 0 = recompute every step */
 } carom_world_def;
 
 static inline carom_world_def carom_world_def_default(void)
@@ -167,6 +172,7 @@ static inline carom_world_def carom_world_def_default(void)
     d.body_capacity = 0;
     d.event_callback = 0;
     d.event_context = 0;
+    d.contact_reuse_distance = 1e-4;
     return d;
 }
 
