@@ -19,8 +19,9 @@ static void add_pair(void *ctx, int ida, int idb)
     contact *c = &w->contacts.items[ci];
     int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
     /* material mixing: friction sqrt(mu1 mu2), restitution max(e1, e2) */
-    c->friction = sqrt(s->friction[a] * s->friction[b]);
-    c->restitution = dmax(s->restitution[a], s->restitution[b]);
+    contact_data *d = &w->contacts.data[ci];
+    d->friction = sqrt(s->friction[a] * s->friction[b]);
+    d->restitution = dmax(s->restitution[a], s->restitution[b]);
 }
 
 int world_update_pairs(carom_world *w)
@@ -57,16 +58,16 @@ int world_update_pairs(carom_world *w)
     return 1;
 }
 
-static void push_touch_event(carom_world *w, const contact *c, carom_event_type type)
+static void push_touch_event(carom_world *w, const contact *c, const contact_data *d, carom_event_type type)
 {
     carom_contact_event e;
     memset(&e, 0, sizeof e);
     e.type = type;
     e.a = world_make_id(w, c->id_a);
     e.b = world_make_id(w, c->id_b);
-    e.normal.x = c->m.normal.x; e.normal.y = c->m.normal.y; e.normal.z = c->m.normal.z;
-    if (c->m.count > 0) {
-        vec3 p = c->m.points[0].point;
+    e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
+    if (d->m.count > 0) {
+        vec3 p = d->m.points[0].point;
         e.point.x = p.x; e.point.y = p.y; e.point.z = p.z;
     }
     world_push_event(w, &e);
@@ -84,36 +85,65 @@ static xform relative_pose(xform xa, xform xb)
  * moves micrometres a step): each separation changes by the normal component
  * of that motion, exact to first order, the point by half of it. Returns 1
  * when the manifold was kept. */
-static int reuse_manifold(contact *c, xform xa, xform xb, double reuse)
+static int reuse_manifold(const contact *c, contact_data *d, xform xa, xform xb, double reuse)
 {
-    if (!(c->flags & CONTACT_REUSABLE) || c->m.count == 0 || !(reuse > 0)) return 0;
+    if (!(c->flags & CONTACT_REUSABLE) || d->m.count == 0 || !(reuse > 0)) return 0;
     xform now = relative_pose(xa, xb);
     if (v3_len2(v3_sub(now.p, c->rel_pose.p)) > reuse * reuse) return 0;
     vec3 moved[MANIFOLD_MAX_POINTS];
-    for (int i = 0; i < c->m.count; i++) {
-        vec3 then = c->state[i].local_a;
+    for (int i = 0; i < d->m.count; i++) {
+        vec3 then = d->state[i].local_a;
         vec3 in_b = xf_inv_point(c->rel_pose, then); /* B's material there, in B's frame */
         moved[i] = v3_sub(xf_point(now, in_b), then);
         if (!(v3_len2(moved[i]) <= reuse * reuse)) return 0;
     }
-    c->m.normal = q_rotate(xa.q, c->normal_a);
-    for (int i = 0; i < c->m.count; i++) {
-        c->m.points[i].separation = c->state[i].separation + v3_dot(c->normal_a, moved[i]);
-        c->m.points[i].point = xf_point(xa, v3_madd(c->state[i].local_a, 0.5, moved[i]));
+    d->m.normal = q_rotate(xa.q, d->normal_a);
+    for (int i = 0; i < d->m.count; i++) {
+        d->m.points[i].separation = d->state[i].separation + v3_dot(d->normal_a, moved[i]);
+        d->m.points[i].point = xf_point(xa, v3_madd(d->state[i].local_a, 0.5, moved[i]));
     }
     return 1;
 }
 
-/* Records the pose a freshly computed manifold belongs to (see reuse_manifold). */
-static void remember_pose(contact *c, xform xa, xform xb)
+/* Largest distance any point of B can have moved relative to A since
+ * rel_pose: B's origin's travel plus the chord of B's rotation at its reach. */
+static double travel_bound(const contact *c, xform now)
 {
-    if (c->m.count == 0) {
-        c->flags &= ~(uint32_t)CONTACT_REUSABLE;
+    quat q0 = c->rel_pose.q, q1 = now.q;
+    double d = q0.w * q1.w + q0.x * q1.x + q0.y * q1.y + q0.z * q1.z;
+    return v3_len(v3_sub(now.p, c->rel_pose.p)) + 2.0 * c->reach_b * sqrt(dmax(0.0, 1.0 - d * d));
+}
+
+/* A pair found apart by more than the look-ahead stays apart (no narrowphase)
+ * while the motion since cannot have closed the gap down to the look-ahead. */
+static int still_apart(const contact *c, xform xa, xform xb, double spec)
+{
+    if (!(c->flags & CONTACT_APART)) return 0;
+    return travel_bound(c, relative_pose(xa, xb)) < c->gap - spec;
+}
+
+/* Records the pose a freshly computed manifold belongs to (see reuse_manifold,
+ * still_apart). An empty one stores the separation of the two shapes along
+ * its normal, a lower bound on their distance. */
+static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa, const shape *sb, xform xb, double spec)
+{
+    c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
+    if (d->m.count == 0) {
+        if (sa->type == SHAPE_PLANE || sb->type == SHAPE_PLANE) return; /* cheap anyway; no finite reach */
+        vec3 n = d->m.normal;
+        vec3 top_a = xf_point(xa, shape_support_local(sa, q_inv_rotate(xa.q, n)));
+        vec3 low_b = xf_point(xb, shape_support_local(sb, q_inv_rotate(xb.q, v3_neg(n))));
+        double gap = v3_dot(n, v3_sub(low_b, top_a));
+        if (!(gap > spec) || !isfinite(gap)) return;
+        c->rel_pose = relative_pose(xa, xb);
+        c->gap = gap;
+        c->reach_b = shape_bounding_radius(sb);
+        c->flags |= CONTACT_APART;
         return;
     }
     c->rel_pose = relative_pose(xa, xb);
-    c->normal_a = q_inv_rotate(xa.q, c->m.normal);
-    for (int i = 0; i < c->m.count; i++) c->state[i].separation = c->m.points[i].separation;
+    d->normal_a = q_inv_rotate(xa.q, d->m.normal);
+    for (int i = 0; i < d->m.count; i++) d->state[i].separation = d->m.points[i].separation;
     c->flags |= CONTACT_REUSABLE;
 }
 
@@ -145,13 +175,14 @@ int world_collide(carom_world *w)
      * seen, moves there), so the indices already listed stay valid */
     for (int i = 0; i < cs->count;) {
         contact *c = &cs->items[i];
+        contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
         int awake_a = s->type[a] != CAROM_BODY_STATIC && (s->flags[a] & BODY_AWAKE);
         int awake_b = s->type[b] != CAROM_BODY_STATIC && (s->flags[b] & BODY_AWAKE);
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
-            if (c->flags & CONTACT_TOUCHING) push_touch_event(w, c, CAROM_EVENT_END);
+            if (c->flags & CONTACT_TOUCHING) push_touch_event(w, c, d, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
@@ -162,29 +193,33 @@ int world_collide(carom_world *w)
         /* bounds farther apart than the look-ahead: no point can be within it
          * (the gap between boxes bounds the distance), so skip the narrowphase */
         aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
+        int touching = 0; /* known without reading the manifold where possible */
         if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
             xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-            if (reuse_manifold(c, xa, xb, reuse)) {
-                /* kept: ids, impulses and feature cache stay as they were */
-            } else if (c->m.count == 0) {
+            if (reuse_manifold(c, d, xa, xb, reuse)) {
+                touching = 1; /* kept: ids, impulses and feature cache stay as they were */
+            } else if (still_apart(c, xa, xb, spec)) {
+                touching = 0;
+            } else if (d->m.count == 0) {
                 /* most pairs near contact: nothing to carry over, nothing to copy */
                 manifold none;
                 none.count = 0;
-                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
-                if (c->m.count > 0) contact_match_points(c, &none, c->state, xa);
-                remember_pose(c, xa, xb);
+                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+                if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
+                remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+                touching = d->m.count > 0;
             } else {
-                manifold old_m = c->m;
+                manifold old_m = d->m;
                 contact_point_state old_state[MANIFOLD_MAX_POINTS];
-                memcpy(old_state, c->state, sizeof old_state[0] * (size_t)old_m.count);
-                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &c->m);
-                if (c->m.count > 0) contact_match_points(c, &old_m, old_state, xa);
-                remember_pose(c, xa, xb);
+                memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
+                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+                if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
+                remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+                touching = d->m.count > 0;
             }
         } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
-            c->m.count = 0;
+            d->m.count = 0;
         }
-        int touching = c->m.count > 0;
         int was = (c->flags & CONTACT_TOUCHING) != 0;
         c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
                    (touching ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
@@ -193,8 +228,8 @@ int world_collide(carom_world *w)
             if (!awake_a) wake_for_step(w, a);
             if (!awake_b) wake_for_step(w, b);
         }
-        if (touching && !was) push_touch_event(w, c, CAROM_EVENT_BEGIN);
-        else if (!touching && was) push_touch_event(w, c, CAROM_EVENT_END);
+        if (touching && !was) push_touch_event(w, c, d, CAROM_EVENT_BEGIN);
+        else if (!touching && was) push_touch_event(w, c, d, CAROM_EVENT_END);
         if (touching) sc->touching[sc->touching_count++] = i;
         i++;
     }

@@ -94,6 +94,7 @@ int contact_set_init(contact_set *cs)
 void contact_set_free(contact_set *cs)
 {
     free(cs->items);
+    free(cs->data);
     free(cs->map.keys);
     free(cs->map.values);
     memset(cs, 0, sizeof *cs);
@@ -110,9 +111,11 @@ int contact_add(contact_set *cs, int a, int b)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
+    if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->count + 1, sizeof *cs->data)) return -1;
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);
+    memset(&cs->data[i], 0, sizeof cs->data[i]);
     c->id_a = a < b ? a : b;
     c->id_b = a < b ? b : a;
     c->cache.feature = -1;
@@ -127,12 +130,13 @@ void contact_remove(contact_set *cs, int i)
     int last = cs->count - 1;
     if (i != last) {
         cs->items[i] = cs->items[last];
+        cs->data[i] = cs->data[last];
         map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), i);
     }
     cs->count--;
 }
 
-void contact_match_points(contact *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
+void contact_match_points(contact_data *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
                           xform xa)
 {
     /* Points keep their impulses when the same features touch again; a point

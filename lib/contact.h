@@ -11,7 +11,8 @@ enum {
     CONTACT_TOUCHING     = 1u << 0,   /* manifold has points this step */
     CONTACT_WAS_TOUCHING = 1u << 1,
     CONTACT_SIM          = 1u << 2,   /* solved this step (both bodies not asleep) */
-    CONTACT_REUSABLE     = 1u << 3    /* rel_pose and the points' local_a/separation are valid */
+    CONTACT_REUSABLE     = 1u << 3,   /* rel_pose and the points' local_a/separation are valid */
+    CONTACT_APART        = 1u << 4    /* no manifold: rel_pose, gap and reach_b are valid */
 };
 
 typedef struct contact_point_state {
@@ -21,17 +22,26 @@ typedef struct contact_point_state {
     double separation;          /* its separation then (a reused manifold updates from it) */               /* point in A's body frame (fallback matching) */
 } contact_point_state;
 
+/* What the collision stage reads for every broadphase pair, touching or not
+ * (most are not): the first line holds what a pair with far-apart bounds
+ * needs, the second what a pair known to be apart needs. */
 typedef struct contact {
     int id_a, id_b;             /* body id-table indices, id_a < id_b */
     uint32_t flags;
-    double friction, restitution;
     collide_cache cache;
+    xform rel_pose;             /* B's frame in A's when the manifold was computed */
+    double gap, reach_b;        /* apart: a lower bound on the distance then, and B's
+                                   bounding radius (how far B's surface reaches) */
+} contact;
+
+/* The manifold and warm-start state of a pair, at the same index. */
+typedef struct contact_data {
+    double friction, restitution; /* mixed from the two bodies' materials */
     manifold m;
     contact_point_state state[MANIFOLD_MAX_POINTS];
     vec3 tangent1;              /* friction basis kept across steps */
-    xform rel_pose;             /* B's frame in A's when the manifold was computed */
-    vec3 normal_a;              /* the manifold normal in A's frame then */
-} contact;
+    vec3 normal_a;              /* the manifold normal in A's frame when computed */
+} contact_data;
 
 /* Open-addressing map from an ordered pair of id indices to a contact index. */
 typedef struct pair_map {
@@ -43,7 +53,8 @@ typedef struct pair_map {
 
 typedef struct contact_set {
     contact *items;
-    int count, capacity;
+    contact_data *data;         /* parallel to items */
+    int count, capacity, data_capacity;
     pair_map map;
 } contact_set;
 
@@ -56,7 +67,7 @@ int contact_add(contact_set *cs, int a, int b);
 /* Swap-removes contact i. */
 void contact_remove(contact_set *cs, int i);
 /* Carries warm-start impulses from the old manifold to the new one. */
-void contact_match_points(contact *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
+void contact_match_points(contact_data *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
                           xform xa);
 
 #endif

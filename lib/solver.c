@@ -321,7 +321,7 @@ int world_solve(carom_world *w, double dt)
     /* constraints from touching manifolds */
     /* the collision stage listed them: no scan over every pair */
     int ncon = s->touching_count, npoints = 0;
-    for (int c = 0; c < ncon; c++) npoints += cs->items[s->touching[c]].m.count;
+    for (int c = 0; c < ncon; c++) npoints += cs->data[s->touching[c]].m.count;
     /* one block: constraints, then their points packed (most pairs of round
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
@@ -346,24 +346,25 @@ int world_solve(carom_world *w, double dt)
     for (int t = 0; t < ncon; t++) {
         int i = s->touching[t];
         contact *ct = &cs->items[i];
+        contact_data *cd = &cs->data[i];
         int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
         contact_constraint *c = &cc[k++];
         c->a = bs->solver_index[sa];
         c->b = bs->solver_index[sb];
         c->contact = i;
-        c->count = ct->m.count;
+        c->count = cd->m.count;
         c->p = point_pool;
         point_pool += c->count;
-        c->n = ct->m.normal;
+        c->n = cd->m.normal;
         /* keep the friction basis stable across steps while the normal holds still */
-        vec3 t1 = v3_sub(ct->tangent1, v3_scale(c->n, v3_dot(ct->tangent1, c->n)));
+        vec3 t1 = v3_sub(cd->tangent1, v3_scale(c->n, v3_dot(cd->tangent1, c->n)));
         if (v3_len2(t1) < 0.25) { vec3 t2; v3_basis(c->n, &t1, &t2); }
         t1 = v3_normalize(t1);
-        ct->tangent1 = t1;
+        cd->tangent1 = t1;
         c->t1 = t1;
         c->t2 = v3_cross(c->n, t1);
-        c->friction = ct->friction;
-        c->restitution = def->enable_restitution ? ct->restitution : 0.0;
+        c->friction = cd->friction;
+        c->restitution = def->enable_restitution ? cd->restitution : 0.0;
         c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? static_soft : soft;
         impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
         vec3 ca = bs->center[sa], cb = bs->center[sb];
@@ -373,7 +374,7 @@ int world_solve(carom_world *w, double dt)
         double an = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
         contacts_touching++;
         for (int j = 0; j < c->count; j++) {
-            const manifold_point *mp = &ct->m.points[j];
+            const manifold_point *mp = &cd->m.points[j];
             constraint_point *p = &c->p[j];
             p->ra = v3_sub(mp->point, ca);
             p->rb = v3_sub(mp->point, cb);
@@ -404,9 +405,9 @@ int world_solve(carom_world *w, double dt)
                  * approach speed at impact, v^2 = v0^2 + 2 |a| gap */
                 p->relative_velocity = -sqrt(p->relative_velocity * p->relative_velocity - 2.0 * an * mp->separation);
             }
-            p->normal_impulse = ws * ct->state[j].normal_impulse;
-            p->tangent_impulse[0] = ws * ct->state[j].tangent_impulse[0];
-            p->tangent_impulse[1] = ws * ct->state[j].tangent_impulse[1];
+            p->normal_impulse = ws * cd->state[j].normal_impulse;
+            p->tangent_impulse[0] = ws * cd->state[j].tangent_impulse[0];
+            p->tangent_impulse[1] = ws * cd->state[j].tangent_impulse[1];
             p->total_normal_impulse = 0.0;
             p->max_normal_impulse = 0.0;
             if (penalty) {
@@ -509,13 +510,14 @@ int world_solve(carom_world *w, double dt)
     for (int c = 0; c < ncon; c++) {
         contact_constraint *con = &cc[c];
         contact *ct = &cs->items[con->contact];
+        contact_data *cd = &cs->data[con->contact];
         double approach = 0.0, total = 0.0, tangent = 0.0;
         int deepest = 0;
         for (int j = 0; j < con->count; j++) {
             constraint_point *p = &con->p[j];
-            ct->state[j].normal_impulse = p->normal_impulse;
-            ct->state[j].tangent_impulse[0] = p->tangent_impulse[0];
-            ct->state[j].tangent_impulse[1] = p->tangent_impulse[1];
+            cd->state[j].normal_impulse = p->normal_impulse;
+            cd->state[j].tangent_impulse[0] = p->tangent_impulse[0];
+            cd->state[j].tangent_impulse[1] = p->tangent_impulse[1];
             total += p->total_normal_impulse;
             tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;
             if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
@@ -526,7 +528,7 @@ int world_solve(carom_world *w, double dt)
             e.type = CAROM_EVENT_HIT;
             e.a = world_make_id(w, ct->id_a);
             e.b = world_make_id(w, ct->id_b);
-            vec3 pt = ct->m.points[deepest].point;
+            vec3 pt = cd->m.points[deepest].point;
             e.point.x = pt.x; e.point.y = pt.y; e.point.z = pt.z;
             e.normal.x = con->n.x; e.normal.y = con->n.y; e.normal.z = con->n.z;
             e.normal_impulse = total;

@@ -627,7 +627,8 @@ static void test_kept_manifolds_match_fresh(void **state)
         carom_body_set_angular_velocity(w, box, vec(0.0005, 0, 0.002));
         assert_int_equal(w->contacts.count, 1);
         contact *c = &w->contacts.items[0];
-        assert_true(c->m.count == 4);
+        contact_data *cd = &w->contacts.data[0];
+        assert_true(cd->m.count == 4);
         int same = memcmp(&c->rel_pose, &last_rel, sizeof last_rel) == 0;
         if (same) kept++; else fresh++;
         last_rel = c->rel_pose;
@@ -635,14 +636,14 @@ static void test_kept_manifolds_match_fresh(void **state)
         collide_cache cache = c->cache;
         manifold m;
         collide(&bs->shapes[sa], pose[sa], &bs->shapes[sb], pose[sb], wd.speculative_distance, &cache, &m);
-        assert_int_equal(m.count, c->m.count);
-        assert_true(v3_len(v3_sub(m.normal, c->m.normal)) < 1e-9);
-        for (int i = 0; i < c->m.count; i++) {
+        assert_int_equal(m.count, cd->m.count);
+        assert_true(v3_len(v3_sub(m.normal, cd->m.normal)) < 1e-9);
+        for (int i = 0; i < cd->m.count; i++) {
             int j = 0;
-            while (j < m.count && m.points[j].id != c->m.points[i].id) j++;
+            while (j < m.count && m.points[j].id != cd->m.points[i].id) j++;
             assert_true(j < m.count);
-            double ds = fabs(m.points[j].separation - c->m.points[i].separation);
-            double dp = v3_len(v3_sub(m.points[j].point, c->m.points[i].point));
+            double ds = fabs(m.points[j].separation - cd->m.points[i].separation);
+            double dp = v3_len(v3_sub(m.points[j].point, cd->m.points[i].point));
             if (!(ds < 1e-7 && dp <= wd.contact_reuse_distance)) {
                 print_error("step %d point %d: separation off by %.3g m, point by %.3g m\n", step, i, ds, dp);
                 fail();
