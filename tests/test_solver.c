@@ -381,13 +381,13 @@ static void test_feature_ids_stable(void **state)
     int ci = contact_find(&w->contacts, ia, ib);
     assert_true(ci >= 0);
     uint32_t ids[4];
-    assert_int_equal(w->contacts.items[ci].m.count, 4);
-    for (int j = 0; j < 4; j++) ids[j] = w->contacts.items[ci].m.points[j].id;
+    assert_int_equal(w->contacts.data[ci].m.count, 4);
+    for (int j = 0; j < 4; j++) ids[j] = w->contacts.data[ci].m.points[j].id;
     for (int s = 0; s < 600; s++) {
         step_n(w, 1, DT);
         ci = contact_find(&w->contacts, ia, ib);
         assert_true(ci >= 0);
-        const manifold *m = &w->contacts.items[ci].m;
+        const manifold *m = &w->contacts.data[ci].m;
         assert_int_equal(m->count, 4);
         for (int j = 0; j < 4; j++) assert_int_equal(m->points[j].id, ids[j]);
     }
