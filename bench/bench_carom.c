@@ -43,7 +43,10 @@ static void run_scene(SceneDesc *sc)
         carom_body_get_kinetic_energy(w, ids[i], &fin[i].ke);
     }
     double pen = sc->id == SC_PILE ? carom_world_measure_max_penetration(w) : -1.0;
-    scene_report("carom", sc, fin, t1 - t0, pen, sc->steps);
+    /* a preset shows as its own engine row: carom_fast, carom_accurate */
+    char engine[32] = "carom";
+    if (preset && strcmp(preset, "default") != 0) snprintf(engine, sizeof engine, "carom_%s", preset);
+    scene_report(engine, sc, fin, t1 - t0, pen, sc->steps);
     free(ids);
     free(fin);
     carom_world_destroy(w);

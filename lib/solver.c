@@ -342,13 +342,13 @@ int world_solve(carom_world *w, double dt)
     double max_pen = 0.0;
     int contacts_touching = 0, points = 0;
 
-    int k = 0;
-    for (int t = 0; t < ncon; t++) {
-        int i = s->touching[t];
+    /* constraint headers first: the colouring needs only the bodies */
+    for (int k = 0; k < ncon; k++) {
+        int i = s->touching[k];
         contact *ct = &cs->items[i];
         contact_data *cd = &cs->data[i];
         int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
-        contact_constraint *c = &cc[k++];
+        contact_constraint *c = &cc[k];
         c->a = bs->solver_index[sa];
         c->b = bs->solver_index[sb];
         c->contact = i;
@@ -366,16 +366,43 @@ int world_solve(carom_world *w, double dt)
         c->friction = cd->friction;
         c->restitution = def->enable_restitution ? cd->restitution : 0.0;
         c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? static_soft : soft;
+        c->wide_batch = -1;
+        contacts_touching++;
+    }
+    int shock = 0;
+    if (def->shock_propagation && !penalty) {
+        /* cheap test first: scenes without a heavy-on-light contact pay nothing */
+        for (int c = 0; c < ncon && !shock; c++) {
+            double ia = bodies[cc[c].a].inv_mass, ib = bodies[cc[c].b].inv_mass;
+            shock = (ia > 0 && ib >= SHOCK_MASS_RATIO * ia) || (ib > 0 && ia >= SHOCK_MASS_RATIO * ib);
+        }
+        if (shock) shock = compute_levels(cc, ncon, bodies, level, nb, order, count_buf);
+    }
+
+    /* the wide passes; shock propagation and penalty springs keep the scalar
+     * order (the shock pass reads each point's impulse between passes) */
+    wide_set *wide = NULL;
+    if (!penalty && !shock && ncon >= WIDE_MIN_CONSTRAINTS) {
+        wide = wide_plan(&s->wide, &s->wide_capacity, cc, ncon, nb);
+        if (!wide) return 0;
+    }
+
+    /* the points: a wide-solved manifold's rows go straight to its lane, and
+     * its scalar point keeps what restitution and the events read */
+    for (int k = 0; k < ncon; k++) {
+        contact_constraint *c = &cc[k];
+        const contact *ct = &cs->items[c->contact];
+        contact_data *cd = &cs->data[c->contact];
+        int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
         impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
         vec3 ca = bs->center[sa], cb = bs->center[sb];
         /* relative normal acceleration from gravity (b relative to a) */
-        double ga = bodies[c->a].inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
-        double gb = bodies[c->b].inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
+        double ga = A->inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
+        double gb = B->inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
         double an = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
-        contacts_touching++;
         for (int j = 0; j < c->count; j++) {
             const manifold_point *mp = &cd->m.points[j];
-            constraint_point *p = &c->p[j];
+            constraint_point point, *p = c->wide_batch >= 0 ? &point : &c->p[j];
             p->ra = v3_sub(mp->point, ca);
             p->rb = v3_sub(mp->point, cb);
             p->ra_n = v3_cross(p->ra, c->n);
@@ -417,26 +444,19 @@ int world_solve(carom_world *w, double dt)
                 p->normal_impulse = 0.0;
                 p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
             }
+            if (p == &point) {
+                wide_set_point(wide, c, j, p);
+                constraint_point *cold = &c->p[j];
+                cold->ra = p->ra;
+                cold->rb = p->rb;
+                cold->normal_mass = p->normal_mass;
+                cold->tangent_mass[0] = p->tangent_mass[0];
+                cold->tangent_mass[1] = p->tangent_mass[1];
+                cold->relative_velocity = p->relative_velocity;
+            }
             if (-mp->separation > max_pen) max_pen = -mp->separation;
             points++;
         }
-    }
-    int shock = 0;
-    if (def->shock_propagation && !penalty) {
-        /* cheap test first: scenes without a heavy-on-light contact pay nothing */
-        for (int c = 0; c < ncon && !shock; c++) {
-            double ia = bodies[cc[c].a].inv_mass, ib = bodies[cc[c].b].inv_mass;
-            shock = (ia > 0 && ib >= SHOCK_MASS_RATIO * ia) || (ib > 0 && ia >= SHOCK_MASS_RATIO * ib);
-        }
-        if (shock) shock = compute_levels(cc, ncon, bodies, level, nb, order, count_buf);
-    }
-
-    /* the wide passes; shock propagation and penalty springs keep the scalar
-     * order (the shock pass reads each point's impulse between passes) */
-    wide_set *wide = NULL;
-    if (!penalty && !shock && ncon >= WIDE_MIN_CONSTRAINTS) {
-        wide = wide_build(&s->wide, &s->wide_capacity, cc, ncon, nb);
-        if (!wide) return 0;
     }
 
     solve_context sc = {bodies, s->delta_position, s->delta_rotation, 1.0 / h,

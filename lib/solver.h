@@ -36,6 +36,7 @@ typedef struct contact_constraint {
     double friction, restitution;
     softness soft;
     constraint_point *p;         /* count points in the step's packed point array */
+    int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
 } contact_constraint;
 
 softness make_softness(double hertz, double damping_ratio, double h);
@@ -59,8 +60,12 @@ void warm_start_constraint(contact_constraint *c, impulse_body *bodies);
 /* Wide passes (solver_wide.c): constraints coloured so that none in a colour
  * shares a moving body, packed four to a batch. */
 typedef struct wide_set wide_set;
-/* Builds the batches in *mem (grown as needed); NULL on out of memory. */
-wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
+/* Colours the constraints and lays out the batches in *mem (grown as
+ * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
+ * and filling the batch headers; NULL on out of memory. */
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
+/* Fills point i of a wide constraint's lane. */
+void wide_set_point(wide_set *ws, const contact_constraint *c, int i, const constraint_point *p);
 void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies);
 void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias);
 /* Writes the batches' impulses back to the constraints' points. */

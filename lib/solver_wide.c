@@ -65,7 +65,8 @@ struct wide_set {
 
 static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
 
-static void fill_lane(wide_batch *wb, wide_point *wp, int l, int ci, const contact_constraint *c)
+/* A lane's batch header: the manifold's bodies, basis and material. */
+static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint *c)
 {
     wb->a[l] = c->a;
     wb->b[l] = c->b;
@@ -79,34 +80,37 @@ static void fill_lane(wide_batch *wb, wide_point *wp, int l, int ci, const conta
     wb->bias_rate[l] = c->soft.bias_rate;
     wb->mass_scale[l] = c->soft.mass_scale;
     wb->impulse_scale[l] = c->soft.impulse_scale;
-    for (int i = 0; i < c->count; i++) {
-        const constraint_point *p = &c->p[i];
-        wide_point *q = &wp[i];
-        q->base_separation[l] = p->base_separation;
-        q->normal_mass[l] = p->normal_mass;
-        q->normal_impulse[l] = p->normal_impulse;
-        q->total_normal_impulse[l] = p->total_normal_impulse;
-        q->max_normal_impulse[l] = p->max_normal_impulse;
-        for (int d = 0; d < 3; d++) {
-            q->ra_n[d][l] = v3_get(p->ra_n, d);
-            q->rb_n[d][l] = v3_get(p->rb_n, d);
-            q->ia_n[d][l] = v3_get(p->ia_n, d);
-            q->ib_n[d][l] = v3_get(p->ib_n, d);
-            for (int k = 0; k < 2; k++) {
-                q->ra_t[k][d][l] = v3_get(p->ra_t[k], d);
-                q->rb_t[k][d][l] = v3_get(p->rb_t[k], d);
-                q->ia_t[k][d][l] = v3_get(p->ia_t[k], d);
-                q->ib_t[k][d][l] = v3_get(p->ib_t[k], d);
-            }
-        }
+}
+
+void wide_set_point(wide_set *ws, const contact_constraint *c, int i, const constraint_point *p)
+{
+    const wide_batch *wb = &ws->batches[c->wide_batch];
+    wide_point *q = &ws->points[wb->first + i];
+    int l = c->wide_lane;
+    q->base_separation[l] = p->base_separation;
+    q->normal_mass[l] = p->normal_mass;
+    q->normal_impulse[l] = p->normal_impulse;
+    q->total_normal_impulse[l] = p->total_normal_impulse;
+    q->max_normal_impulse[l] = p->max_normal_impulse;
+    for (int d = 0; d < 3; d++) {
+        q->ra_n[d][l] = v3_get(p->ra_n, d);
+        q->rb_n[d][l] = v3_get(p->rb_n, d);
+        q->ia_n[d][l] = v3_get(p->ia_n, d);
+        q->ib_n[d][l] = v3_get(p->ib_n, d);
         for (int k = 0; k < 2; k++) {
-            q->tangent_mass[k][l] = p->tangent_mass[k];
-            q->tangent_impulse[k][l] = p->tangent_impulse[k];
+            q->ra_t[k][d][l] = v3_get(p->ra_t[k], d);
+            q->rb_t[k][d][l] = v3_get(p->rb_t[k], d);
+            q->ia_t[k][d][l] = v3_get(p->ia_t[k], d);
+            q->ib_t[k][d][l] = v3_get(p->ib_t[k], d);
         }
+    }
+    for (int k = 0; k < 2; k++) {
+        q->tangent_mass[k][l] = p->tangent_mass[k];
+        q->tangent_impulse[k][l] = p->tangent_impulse[k];
     }
 }
 
-wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
 {
     /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
     int max_batches = ncon / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
@@ -147,6 +151,7 @@ wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int n
         uint32_t taken = (a ? used[a] : 0) | (b ? used[b] : 0);
         int c = 0;
         while (c < WIDE_COLORS && (taken >> c & 1u)) c++;
+        cc[k].wide_batch = cc[k].wide_lane = -1;
         if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1) {
             color[k] = -1;
             ws->overflow[ws->overflow_count++] = k;
@@ -184,8 +189,10 @@ wide_set *wide_build(void **mem, size_t *capacity, contact_constraint *cc, int n
         if (c < 0) continue;
         int n = cc[k].count, slot = bucket[c][n]++;
         wide_batch *wb = &ws->batches[start[c][n] + slot / LANES];
-        fill_lane(wb, &ws->points[wb->first], slot % LANES, k, &cc[k]);
+        fill_header(wb, slot % LANES, k, &cc[k]);
         wb->lanes = slot % LANES + 1;
+        cc[k].wide_batch = start[c][n] + slot / LANES;
+        cc[k].wide_lane = slot % LANES;
     }
     ws->batch_count = nbatch;
 #if WIDE_AVX2
