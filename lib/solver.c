@@ -367,6 +367,13 @@ int world_solve(carom_world *w, double dt)
         c->restitution = def->enable_restitution ? cd->restitution : 0.0;
         c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? static_soft : soft;
         c->wide_batch = -1;
+        c->m = &cd->m;
+        c->warm = cd->state;
+        c->center_a = bs->center[sa];
+        c->center_b = bs->center[sb];
+        double ga = bodies[c->a].inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
+        double gb = bodies[c->b].inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
+        c->gravity_closing = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
         contacts_touching++;
     }
     int shock = 0;
@@ -389,20 +396,19 @@ int world_solve(carom_world *w, double dt)
 
     /* the points: a wide-solved manifold's rows go straight to its lane, and
      * its scalar point keeps what restitution and the events read */
+    if (wide) {
+        max_pen = wide_prepare(wide, cc, bodies, ws);
+        points = npoints;
+    }
     for (int k = 0; k < ncon; k++) {
         contact_constraint *c = &cc[k];
-        const contact *ct = &cs->items[c->contact];
-        contact_data *cd = &cs->data[c->contact];
-        int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
+        if (c->wide_batch >= 0) continue; /* prepared above */
         impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
-        vec3 ca = bs->center[sa], cb = bs->center[sb];
-        /* relative normal acceleration from gravity (b relative to a) */
-        double ga = A->inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
-        double gb = B->inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
-        double an = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
+        vec3 ca = c->center_a, cb = c->center_b;
+        double an = c->gravity_closing;
         for (int j = 0; j < c->count; j++) {
-            const manifold_point *mp = &cd->m.points[j];
-            constraint_point point, *p = c->wide_batch >= 0 ? &point : &c->p[j];
+            const manifold_point *mp = &c->m->points[j];
+            constraint_point *p = &c->p[j];
             p->ra = v3_sub(mp->point, ca);
             p->rb = v3_sub(mp->point, cb);
             p->ra_n = v3_cross(p->ra, c->n);
@@ -432,9 +438,9 @@ int world_solve(carom_world *w, double dt)
                  * approach speed at impact, v^2 = v0^2 + 2 |a| gap */
                 p->relative_velocity = -sqrt(p->relative_velocity * p->relative_velocity - 2.0 * an * mp->separation);
             }
-            p->normal_impulse = ws * cd->state[j].normal_impulse;
-            p->tangent_impulse[0] = ws * cd->state[j].tangent_impulse[0];
-            p->tangent_impulse[1] = ws * cd->state[j].tangent_impulse[1];
+            p->normal_impulse = ws * c->warm[j].normal_impulse;
+            p->tangent_impulse[0] = ws * c->warm[j].tangent_impulse[0];
+            p->tangent_impulse[1] = ws * c->warm[j].tangent_impulse[1];
             p->total_normal_impulse = 0.0;
             p->max_normal_impulse = 0.0;
             if (penalty) {
@@ -444,18 +450,8 @@ int world_solve(carom_world *w, double dt)
                 p->normal_impulse = 0.0;
                 p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
             }
-            if (p == &point) {
-                wide_set_point(wide, c, j, p);
-                constraint_point *cold = &c->p[j];
-                cold->ra = p->ra;
-                cold->rb = p->rb;
-                cold->normal_mass = p->normal_mass;
-                cold->tangent_mass[0] = p->tangent_mass[0];
-                cold->tangent_mass[1] = p->tangent_mass[1];
-                cold->relative_velocity = p->relative_velocity;
-            }
             if (-mp->separation > max_pen) max_pen = -mp->separation;
-            points++;
+            if (!wide) points++;
         }
     }
 

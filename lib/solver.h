@@ -37,6 +37,11 @@ typedef struct contact_constraint {
     softness soft;
     constraint_point *p;         /* count points in the step's packed point array */
     int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
+    /* what preparing the points reads */
+    const manifold *m;
+    const contact_point_state *warm; /* last step's impulses, matched by feature */
+    vec3 center_a, center_b;     /* centres of mass */
+    double gravity_closing;      /* normal acceleration of b relative to a from gravity */
 } contact_constraint;
 
 softness make_softness(double hertz, double damping_ratio, double h);
@@ -64,8 +69,10 @@ typedef struct wide_set wide_set;
  * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
  * and filling the batch headers; NULL on out of memory. */
 wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
-/* Fills point i of a wide constraint's lane. */
-void wide_set_point(wide_set *ws, const contact_constraint *c, int i, const constraint_point *p);
+/* Prepares every wide manifold's points four lanes at a time, as solver.c
+ * prepares a scalar one (warm: 1 to warm-start, 0 not); the scalar points
+ * get what restitution and the events read. Returns the deepest overlap. */
+double wide_prepare(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm);
 void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies);
 void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias);
 /* Writes the batches' impulses back to the constraints' points. */

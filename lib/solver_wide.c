@@ -82,34 +82,6 @@ static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint 
     wb->impulse_scale[l] = c->soft.impulse_scale;
 }
 
-void wide_set_point(wide_set *ws, const contact_constraint *c, int i, const constraint_point *p)
-{
-    const wide_batch *wb = &ws->batches[c->wide_batch];
-    wide_point *q = &ws->points[wb->first + i];
-    int l = c->wide_lane;
-    q->base_separation[l] = p->base_separation;
-    q->normal_mass[l] = p->normal_mass;
-    q->normal_impulse[l] = p->normal_impulse;
-    q->total_normal_impulse[l] = p->total_normal_impulse;
-    q->max_normal_impulse[l] = p->max_normal_impulse;
-    for (int d = 0; d < 3; d++) {
-        q->ra_n[d][l] = v3_get(p->ra_n, d);
-        q->rb_n[d][l] = v3_get(p->rb_n, d);
-        q->ia_n[d][l] = v3_get(p->ia_n, d);
-        q->ib_n[d][l] = v3_get(p->ib_n, d);
-        for (int k = 0; k < 2; k++) {
-            q->ra_t[k][d][l] = v3_get(p->ra_t[k], d);
-            q->rb_t[k][d][l] = v3_get(p->rb_t[k], d);
-            q->ia_t[k][d][l] = v3_get(p->ia_t[k], d);
-            q->ib_t[k][d][l] = v3_get(p->ib_t[k], d);
-        }
-    }
-    for (int k = 0; k < 2; k++) {
-        q->tangent_mass[k][l] = p->tangent_mass[k];
-        q->tangent_impulse[k][l] = p->tangent_impulse[k];
-    }
-}
-
 wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
 {
     /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
@@ -387,6 +359,157 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
     scatter(wb, sc->bodies, &lb);
 }
 
+/* Lane l of a batch reads manifold l (an empty lane reads zeros: static body,
+ * no point, no impulse, so every row it gets is zero). */
+typedef struct lane_source {
+    const contact_constraint *c[LANES];
+} lane_source;
+
+#define CROSS(r, a, b)                                  \
+    do {                                                \
+        (r)[0] = (a)[1] * (b)[2] - (a)[2] * (b)[1];     \
+        (r)[1] = (a)[2] * (b)[0] - (a)[0] * (b)[2];     \
+        (r)[2] = (a)[0] * (b)[1] - (a)[1] * (b)[0];     \
+    } while (0)
+/* column-major 3x3 times a vector, as m3_mulv */
+#define MAT_VEC(r, m, v)                                                   \
+    do {                                                                   \
+        for (int d_ = 0; d_ < 3; d_++)                                     \
+            (r)[d_] = (m)[0][d_] * (v)[0] + (m)[1][d_] * (v)[1] + (m)[2][d_] * (v)[2]; \
+    } while (0)
+
+LANE_INLINE void gather_inertia(lane_t out[3][3], const impulse_body *b0, const impulse_body *b1,
+                                const impulse_body *b2, const impulse_body *b3)
+{
+    SET_LANES(out[0][0], b0, b1, b2, b3, inv_inertia.c0.x);
+    SET_LANES(out[0][1], b0, b1, b2, b3, inv_inertia.c0.y);
+    SET_LANES(out[0][2], b0, b1, b2, b3, inv_inertia.c0.z);
+    SET_LANES(out[1][0], b0, b1, b2, b3, inv_inertia.c1.x);
+    SET_LANES(out[1][1], b0, b1, b2, b3, inv_inertia.c1.y);
+    SET_LANES(out[1][2], b0, b1, b2, b3, inv_inertia.c1.z);
+    SET_LANES(out[2][0], b0, b1, b2, b3, inv_inertia.c2.x);
+    SET_LANES(out[2][1], b0, b1, b2, b3, inv_inertia.c2.y);
+    SET_LANES(out[2][2], b0, b1, b2, b3, inv_inertia.c2.z);
+}
+
+LANE_INLINE void gather_vec(lane_t out[3], vec3 v0, vec3 v1, vec3 v2, vec3 v3_)
+{
+    const double x[LANES] = {v0.x, v1.x, v2.x, v3_.x}, y[LANES] = {v0.y, v1.y, v2.y, v3_.y},
+                 z[LANES] = {v0.z, v1.z, v2.z, v3_.z};
+    memcpy(&out[0], x, sizeof out[0]);
+    memcpy(&out[1], y, sizeof out[1]);
+    memcpy(&out[2], z, sizeof out[2]);
+}
+
+LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_constraint *cc,
+                                 const impulse_body *bodies, double warm)
+{
+    static const manifold_point no_point = {{0, 0, 0}, 0, 0};
+    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
+    const impulse_body *A[LANES], *B[LANES];
+    contact_constraint *c[LANES];
+    vec3 ca[LANES], cb[LANES];
+    for (int l = 0; l < LANES; l++) {
+        c[l] = l < wb->lanes ? &cc[wb->con[l]] : NULL;
+        A[l] = &bodies[wb->a[l]];
+        B[l] = &bodies[wb->b[l]];
+        ca[l] = c[l] ? c[l]->center_a : v3_zero();
+        cb[l] = c[l] ? c[l]->center_b : v3_zero();
+    }
+    lane_t ia[3][3], ib[3][3], lb_va[3], lb_wa[3], lb_vb[3], lb_wb[3], ma, mb, center_a[3], center_b[3];
+    gather_inertia(ia, A[0], A[1], A[2], A[3]);
+    gather_inertia(ib, B[0], B[1], B[2], B[3]);
+    gather_vec(lb_va, A[0]->v, A[1]->v, A[2]->v, A[3]->v);
+    gather_vec(lb_wa, A[0]->w, A[1]->w, A[2]->w, A[3]->w);
+    gather_vec(lb_vb, B[0]->v, B[1]->v, B[2]->v, B[3]->v);
+    gather_vec(lb_wb, B[0]->w, B[1]->w, B[2]->w, B[3]->w);
+    SET_LANES(ma, A[0], A[1], A[2], A[3], inv_mass);
+    SET_LANES(mb, B[0], B[1], B[2], B[3], inv_mass);
+    gather_vec(center_a, ca[0], ca[1], ca[2], ca[3]);
+    gather_vec(center_b, cb[0], cb[1], cb[2], cb[3]);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), warm_scale = SPLAT(warm);
+    const lane_t mab = ma + mb;
+    double deepest = 0.0;
+    for (int i = 0; i < wb->count; i++) {
+        wide_point *p = &pts[i];
+        const manifold_point *mp[LANES];
+        const contact_point_state *st[LANES];
+        for (int l = 0; l < LANES; l++) {
+            mp[l] = c[l] ? &c[l]->m->points[i] : &no_point;
+            st[l] = c[l] ? &c[l]->warm[i] : &no_state;
+        }
+        lane_t point[3], sep;
+        gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
+        SET_LANES(sep, mp[0], mp[1], mp[2], mp[3], separation);
+        lane_t ra[3], rb[3];
+        for (int d = 0; d < 3; d++) {
+            ra[d] = point[d] - center_a[d];
+            rb[d] = point[d] - center_b[d];
+        }
+        CROSS(p->ra_n, ra, wb->n);
+        CROSS(p->rb_n, rb, wb->n);
+        MAT_VEC(p->ia_n, ia, p->ra_n);
+        MAT_VEC(p->ib_n, ib, p->rb_n);
+        CROSS(p->ra_t[0], ra, wb->t1);
+        CROSS(p->rb_t[0], rb, wb->t1);
+        CROSS(p->ra_t[1], ra, wb->t2);
+        CROSS(p->rb_t[1], rb, wb->t2);
+        for (int q = 0; q < 2; q++) {
+            MAT_VEC(p->ia_t[q], ia, p->ra_t[q]);
+            MAT_VEC(p->ib_t[q], ib, p->rb_t[q]);
+        }
+        /* effective masses as solver.c: 1 / (1/mA + 1/mB + (IA^-1 (rA x n)).(rA x n) + ...) */
+        lane_t kn = mab + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
+        lane_t k1 = mab + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
+        lane_t k2 = mab + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
+        lane_t ikn = one / SELECT_LANES(kn > zero, kn, one), ik1 = one / SELECT_LANES(k1 > zero, k1, one),
+               ik2 = one / SELECT_LANES(k2 > zero, k2, one);
+        p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
+        p->tangent_mass[0] = SELECT_LANES(k1 > zero, ik1, zero);
+        p->tangent_mass[1] = SELECT_LANES(k2 > zero, ik2, zero);
+        p->base_separation = sep;
+        /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
+        lane_t wxa[3], wxb[3];
+        CROSS(wxa, lb_wa, ra);
+        CROSS(wxb, lb_wb, rb);
+        lane_t vrel[3];
+        for (int d = 0; d < 3; d++) vrel[d] = (lb_vb[d] + wxb[d]) - (lb_va[d] + wxa[d]);
+        lane_t vn = DOT3(vrel, wb->n);
+        lane_t ni, t1, t2;
+        SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
+        SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
+        SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
+        p->normal_impulse = warm_scale * ni;
+        p->tangent_impulse[0] = warm_scale * t1;
+        p->tangent_impulse[1] = warm_scale * t2;
+        p->total_normal_impulse = zero;
+        p->max_normal_impulse = zero;
+        for (int l = 0; l < wb->lanes; l++) {
+            constraint_point *cold = &c[l]->p[i];
+            double v = vn[l], an = c[l]->gravity_closing, s = sep[l];
+            if (v < 0.0 && s > 0.0 && an < 0.0) v = -sqrt(v * v - 2.0 * an * s); /* as solver.c: speed at impact */
+            cold->relative_velocity = v;
+            cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
+            cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
+            cold->normal_mass = p->normal_mass[l];
+            cold->tangent_mass[0] = p->tangent_mass[0][l];
+            cold->tangent_mass[1] = p->tangent_mass[1][l];
+            if (-s > deepest) deepest = -s;
+        }
+    }
+    return deepest;
+}
+
+static double prepare_batches(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm)
+{
+    double deepest = 0.0;
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));
+    }
+    return deepest;
+}
+
 static void warm_batches(wide_set *ws, impulse_body *bodies)
 {
     for (int k = 0; k < ws->batch_count; k++) {
@@ -415,6 +538,17 @@ __attribute__((target("avx2"))) static void warm_batches_avx2(wide_set *ws, impu
     }
 }
 
+__attribute__((target("avx2"))) static double prepare_batches_avx2(wide_set *ws, contact_constraint *cc,
+                                                                   const impulse_body *bodies, double warm)
+{
+    double deepest = 0.0;
+    for (int k = 0; k < ws->batch_count; k++) {
+        wide_batch *wb = &ws->batches[k];
+        deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));
+    }
+    return deepest;
+}
+
 __attribute__((target("avx2"))) static void solve_batches_avx2(wide_set *ws, const solve_context *sc, int use_bias)
 {
     for (int k = 0; k < ws->batch_count; k++) {
@@ -424,6 +558,19 @@ __attribute__((target("avx2"))) static void solve_batches_avx2(wide_set *ws, con
 }
 #endif
 #endif
+
+double wide_prepare(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm)
+{
+#if WIDE_AVX2
+    if (ws->avx2) return prepare_batches_avx2(ws, cc, bodies, warm);
+    return prepare_batches(ws, cc, bodies, warm);
+#elif WIDE_VECTORS
+    return prepare_batches(ws, cc, bodies, warm);
+#else
+    (void)ws; (void)cc; (void)bodies; (void)warm;
+    return 0.0;
+#endif
+}
 
 void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies)
 {
