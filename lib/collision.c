@@ -90,11 +90,15 @@ static int reuse_manifold(const contact *c, contact_data *d, xform xa, xform xb,
     if (!(c->flags & CONTACT_REUSABLE) || d->m.count == 0 || !(reuse > 0)) return 0;
     xform now = relative_pose(xa, xb);
     if (v3_len2(v3_sub(now.p, c->rel_pose.p)) > reuse * reuse) return 0;
+    /* B's motion in A's frame since then, x -> R x + t, as a matrix: one
+     * product per point instead of two quaternion rotations */
+    quat dq = q_mul(now.q, q_conj(c->rel_pose.q));
+    mat3 R = m3_from_quat(dq);
+    vec3 t = v3_sub(now.p, q_rotate(dq, c->rel_pose.p));
     vec3 moved[MANIFOLD_MAX_POINTS];
     for (int i = 0; i < d->m.count; i++) {
-        vec3 then = d->state[i].local_a;
-        vec3 in_b = xf_inv_point(c->rel_pose, then); /* B's material there, in B's frame */
-        moved[i] = v3_sub(xf_point(now, in_b), then);
+        vec3 then = d->state[i].local_a; /* B's material there moves to R then + t */
+        moved[i] = v3_sub(v3_add(m3_mulv(R, then), t), then);
         if (!(v3_len2(moved[i]) <= reuse * reuse)) return 0;
     }
     d->m.normal = q_rotate(xa.q, d->normal_a);
