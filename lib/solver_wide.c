@@ -168,7 +168,8 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
     }
     ws->batch_count = nbatch;
 #if WIDE_AVX2
-    ws->avx2 = __builtin_cpu_supports("avx2") != 0;
+    /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
+    ws->avx2 = __builtin_cpu_supports("avx2") != 0 && !getenv("CAROM_NO_AVX2");
 #else
     ws->avx2 = 0;
 #endif
