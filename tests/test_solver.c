@@ -70,6 +70,7 @@ static void step_n(carom_world *w, int n, double dt)
 #define EXPECT_NEAR(got, want, tol, what)                                                          \
     do {                                                                                           \
         double g_ = (got), w_ = (want);                                                           \
+        print_message("%s: %.6f (expected %.6f)\n", (what), g_, w_);                             \
         if (!(fabs(g_ - w_) <= (tol))) {                                                          \
             print_error("%s: got %.6f, expected %.6f (tolerance %.6f)\n", (what), g_, w_, (double)(tol)); \
             fail();                                                                                \
