@@ -102,8 +102,11 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
     vec3 dpab = v3_sub(sc->dp[c->b], sc->dp[c->a]);
     for (int i = 0; i < c->count; i++) {
         constraint_point *p = &c->p[i];
-        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(sc->dq[c->b], p->rb_n) - v3_dot(sc->dq[c->a], p->ra_n);
-        double k = fa * (A->inv_mass + v3_dot(p->ra_n, p->ia_n)) + fb * (B->inv_mass + v3_dot(p->rb_n, p->ib_n));
+        /* rows from the anchors: a wide-solved point keeps only those */
+        vec3 ra_n = v3_cross(p->ra, n), rb_n = v3_cross(p->rb, n);
+        vec3 ia_n = m3_mulv(A->inv_inertia, ra_n), ib_n = m3_mulv(B->inv_inertia, rb_n);
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(sc->dq[c->b], rb_n) - v3_dot(sc->dq[c->a], ra_n);
+        double k = fa * (A->inv_mass + v3_dot(ra_n, ia_n)) + fb * (B->inv_mass + v3_dot(rb_n, ib_n));
         p->shock_normal = 0.0;
         if (k <= 0) continue;
         /* rigid against an immovable lower body, with the soft push-out rate */
@@ -112,15 +115,15 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         else if (use_bias && sc->correction == CAROM_CORRECTION_SOFT) bias = dmax(c->soft.bias_rate * s, -sc->push_max);
         else if (use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE)
             bias = dmax(sc->baumgarte * sc->inv_h * dmin(s + sc->slop, 0.0), -sc->push_max);
-        double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, p->rb_n) - v3_dot(A->w, p->ra_n);
+        double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, rb_n) - v3_dot(A->w, ra_n);
         /* the pass may pull back at most what the regular solve pushed */
         double lambda = dmax(-(vn + bias) / k, -p->normal_impulse);
         p->shock_normal = lambda;
         p->total_normal_impulse += lambda;
         A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
-        A->w = v3_madd(A->w, -fa * lambda, p->ia_n);
+        A->w = v3_madd(A->w, -fa * lambda, ia_n);
         B->v = v3_madd(B->v, fb * B->inv_mass * lambda, n);
-        B->w = v3_madd(B->w, fb * lambda, p->ib_n);
+        B->w = v3_madd(B->w, fb * lambda, ib_n);
     }
     if (!sc->friction || c->friction <= 0) return;
     for (int i = 0; i < c->count; i++) {
@@ -386,10 +389,10 @@ int world_solve(carom_world *w, double dt)
         if (shock) shock = compute_levels(cc, ncon, bodies, level, nb, order, count_buf);
     }
 
-    /* the wide passes; shock propagation and penalty springs keep the scalar
-     * order (the shock pass reads each point's impulse between passes) */
+    /* the wide passes (penalty springs keep the scalar loop; the shock pass
+     * runs scalar between wide passes, reading the impulses from the lanes) */
     wide_set *wide = NULL;
-    if (!penalty && !shock && ncon >= WIDE_MIN_CONSTRAINTS) {
+    if (!penalty && ncon >= WIDE_MIN_CONSTRAINTS) {
         wide = wide_plan(&s->wide, &s->wide_capacity, cc, ncon, nb);
         if (!wide) return 0;
     }
@@ -485,6 +488,7 @@ int world_solve(carom_world *w, double dt)
             }
             for (int o = 0; o < shock; o++) {
                 contact_constraint *c = &cc[order[o]];
+                if (c->wide_batch >= 0) wide_read_impulses(wide, c);
                 solve_constraint_shock(c, &sc, 1, level[c->a] < level[c->b]);
             }
         }
@@ -509,6 +513,7 @@ int world_solve(carom_world *w, double dt)
             if (def->relax_iterations > 0)
                 for (int o = 0; o < shock; o++) {
                     contact_constraint *c = &cc[order[o]];
+                    if (c->wide_batch >= 0) wide_read_impulses(wide, c);
                     solve_constraint_shock(c, &sc, 0, level[c->a] < level[c->b]);
                 }
             project_planar(w, nb);

@@ -75,6 +75,9 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
 double wide_prepare(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm);
 void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies);
 void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias);
+/* Copies a wide constraint's current impulses to its scalar points (the shock
+ * pass reads them between wide passes). */
+void wide_read_impulses(const wide_set *ws, contact_constraint *c);
 /* Writes the batches' impulses back to the constraints' points. */
 void wide_store(const wide_set *ws, contact_constraint *cc);
 

@@ -490,6 +490,8 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
             double v = vn[l], an = c[l]->gravity_closing, s = sep[l];
             if (v < 0.0 && s > 0.0 && an < 0.0) v = -sqrt(v * v - 2.0 * an * s); /* as solver.c: speed at impact */
             cold->relative_velocity = v;
+            cold->base_separation = s;
+            cold->total_normal_impulse = 0.0;
             cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
             cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
             cold->normal_mass = p->normal_mass[l];
@@ -595,6 +597,18 @@ void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, i
     for (int k = 0; k < ws->overflow_count; k++) solve_constraint(&cc[ws->overflow[k]], sc, use_bias);
 }
 
+void wide_read_impulses(const wide_set *ws, contact_constraint *c)
+{
+    const wide_batch *wb = &ws->batches[c->wide_batch];
+    int l = c->wide_lane;
+    for (int i = 0; i < c->count; i++) {
+        const wide_point *q = &ws->points[wb->first + i];
+        c->p[i].normal_impulse = q->normal_impulse[l];
+        c->p[i].tangent_impulse[0] = q->tangent_impulse[0][l];
+        c->p[i].tangent_impulse[1] = q->tangent_impulse[1][l];
+    }
+}
+
 void wide_store(const wide_set *ws, contact_constraint *cc)
 {
     for (int k = 0; k < ws->batch_count; k++) {
@@ -605,7 +619,7 @@ void wide_store(const wide_set *ws, contact_constraint *cc)
                 const wide_point *q = &ws->points[wb->first + i];
                 constraint_point *p = &c->p[i];
                 p->normal_impulse = q->normal_impulse[l];
-                p->total_normal_impulse = q->total_normal_impulse[l];
+                p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */
                 p->max_normal_impulse = q->max_normal_impulse[l];
                 p->tangent_impulse[0] = q->tangent_impulse[0][l];
                 p->tangent_impulse[1] = q->tangent_impulse[1][l];

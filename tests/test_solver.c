@@ -756,6 +756,35 @@ static void test_wide_kernels_agree(void **state)
     assert_memory_equal(end[0], end[1], sizeof end[0]);
 }
 
+/* Shock propagation inside a step solved wide: 40 light boxes each under a
+ * 1000 kg box (80 manifolds, past the wide threshold) all hold, as the lone
+ * pair does. */
+static void test_mass_ratio_holds_in_a_wide_step(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    wd.enable_sleep = 0;
+    carom_world *w = world_with(wd, 1, 0.5, 0.0);
+    carom_body_id heavy[40];
+    for (int i = 0; i < 40; i++) {
+        double x = 3.0 * (i % 8), y = 3.0 * (i / 8);
+        add_box(w, x, y, 0.5, 0.5, 1.0, 0.5);
+        heavy[i] = add_box(w, x, y, 1.5, 0.5, 1000.0, 0.5);
+    }
+    int most = 0;
+    for (int s = 0; s < 300; s++) {
+        step_n(w, 1, DT);
+        carom_world_stats st = carom_world_stats_init();
+        carom_world_get_stats(w, &st);
+        if (st.contacts > most) most = st.contacts;
+    }
+    assert_true(most >= 64);
+    double worst = 0.0;
+    for (int i = 0; i < 40; i++) worst = fmax(worst, fabs(pos(w, heavy[i]).z - 1.5));
+    EXPECT_NEAR(1.5 + worst, 1.5, 0.01, "worst heavy box height");
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -778,6 +807,7 @@ int main(void)
         cmocka_unit_test(test_kept_manifolds_match_fresh),
         cmocka_unit_test(test_skipped_pairs_are_apart),
         cmocka_unit_test(test_wide_kernels_agree),
+        cmocka_unit_test(test_mass_ratio_holds_in_a_wide_step),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
