@@ -1,10 +1,10 @@
-/* solver_wide.c - the warm-start, solve and relax passes over batches of four
- * independent manifolds. Sequential impulses on one manifold form a chain of
- * dependent floating-point operations (each row reads the velocity the last
- * row wrote), so a scalar pass runs at the latency of that chain. Greedy graph
- * colouring puts manifolds that share no moving body in one colour; within a
- * colour, manifolds with the same number of points are packed four to a batch,
- * field by field, and the four chains run side by side. Each manifold is still
+/* solver_wide.c - the point preparation and the warm-start, solve and relax
+ * passes over batches of four independent manifolds, one vector instruction
+ * doing the work of four scalar ones (the passes are bound by arithmetic:
+ * interleaving four manifolds with scalar code gained only a quarter of what
+ * the vectors do). Greedy graph colouring puts manifolds that share no moving
+ * body in one colour; within a colour, manifolds with the same number of
+ * points are packed four to a batch, field by field. Each manifold is still
  * solved point by point exactly as in solver.c; only the order between
  * manifolds becomes colour by colour. Manifolds beyond the last colour keep
  * the scalar pass. */
