@@ -261,9 +261,22 @@ static void shape_plane(const shape *a, xform xa, const shape *b, xform xb, doub
         break;
     }
     case SHAPE_BOX: case SHAPE_HULL: {
+        /* the face turned to the plane, and the deepest vertex: a body smaller
+         * than the look-ahead has every vertex within it, and letting the far
+         * face's vertices into the four points would leave it standing on
+         * fewer than its real supports (a 1 cm box then rocked and walked) */
         poly p;
         if (!poly_from_shape(&p, a, xa)) return;
-        for (int i = 0; i < p.nv; i++) {
+        int face = 0, deepest = 0;
+        for (int f = 1; f < p.nf; f++)
+            if (v3_dot(p.fn[f], n) < v3_dot(p.fn[face], n)) face = f;
+        for (int i = 1; i < p.nv; i++)
+            if (v3_dot(n, p.v[i]) < v3_dot(n, p.v[deepest])) deepest = i;
+        unsigned char keep[POLY_MAX_V] = {0};
+        for (int k = 0; k < p.fcount[face]; k++) keep[p.fv[p.ffirst[face] + k]] = 1;
+        keep[deepest] = 1;
+        for (int i = 0; i < p.nv; i++) { /* in vertex order, as the ids */
+            if (!keep[i]) continue;
             double sep = v3_dot(n, p.v[i]) - d;
             if (sep < spec) {
                 cand[nc].point = v3_madd(p.v[i], -0.5 * sep, n);

@@ -213,6 +213,28 @@ static void test_huge_velocities(void **state)
     }
 }
 
+/* A 1 cm box on the ground with every manifold recomputed every step (no
+ * reuse): it stays where it was put, flat (its eight corners are all within
+ * the 2 cm look-ahead; the manifold must still be the bottom face's). */
+static void test_small_box_rests_without_reuse(void **state)
+{
+    (void)state;
+    carom_world_def d = carom_world_def_default();
+    d.contact_reuse_distance = 0.0;
+    carom_world *w = ground_world(d);
+    carom_body_id id = box_at(w, 0, 0, 0.005, 0.005, 1e-3);
+    run(w, 600, 1.0 / 60);
+    carom_vec3 p = pos(w, id);
+    carom_quat q;
+    assert_int_equal(carom_body_get_orientation(w, id, &q), CAROM_OK);
+    double drift = sqrt(p.x * p.x + p.y * p.y), tilt = 2.0 * acos(fmin(1.0, fabs(q.w)));
+    print_message("1 cm box: drift %.3g m, sank %.3g m, tilt %.3g rad\n", drift, 0.005 - p.z, tilt);
+    assert_true(drift < 1e-4);
+    assert_true(fabs(p.z - 0.005) < 5e-4);
+    assert_true(tilt < 0.01);
+    carom_world_destroy(w);
+}
+
 static void test_soak(void **state)
 {
     (void)state;
@@ -256,6 +278,7 @@ int main(void)
         cmocka_unit_test(test_far_from_origin),
         cmocka_unit_test(test_time_steps),
         cmocka_unit_test(test_huge_velocities),
+        cmocka_unit_test(test_small_box_rests_without_reuse),
         cmocka_unit_test(test_soak),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -330,6 +330,19 @@ static void test_box_plane(void **state)
     /* all four corners distinct */
     for (int i = 0; i < 4; i++)
         for (int j = i + 1; j < 4; j++) assert_true(v3_len(v3_sub(m.points[i].point, m.points[j].point)) > 0.5);
+    /* a 1 cm box, all eight corners within the 2 cm look-ahead: the four points
+     * are still the bottom face's (a top corner among them leaves the box
+     * standing on fewer supports than it has) */
+    shape small = box(0.005, 0.005, 0.005);
+    assert_int_equal(run_both(&small, at_rot(0.3, -0.2, 0.005, v3(0, 0, 1), 0.4), &g, at(0, 0, 0), 0.02, &m), 4);
+    for (int i = 0; i < 4; i++) NEAR(m.points[i].separation, 0, 1e-12);
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++) assert_true(v3_len(v3_sub(m.points[i].point, m.points[j].point)) > 0.005);
+    /* tilted 0.2 rad onto an edge: the top face's corners stick out farther in
+     * the plane than the bottom face's, and still must not be chosen */
+    double th = 0.2, z0 = 0.005 * (cos(th) + sin(th));
+    assert_int_equal(run_both(&small, at_rot(0, 0, z0, v3(1, 0, 0), th), &g, at(0, 0, 0), 0.02, &m), 4);
+    for (int i = 0; i < 4; i++) assert_true(m.points[i].separation < 0.01 * sin(th) + 1e-12);
     /* 45 degrees about x: an edge down, two points at depth 0.05 */
     double h = 0.5 * sqrt(2.0);
     assert_int_equal(run_both(&b, at_rot(0, 0, h - 0.05, v3(1, 0, 0), 0.25 * PI), &g, at(0, 0, 0), 0.02, &m), 2);
