@@ -367,7 +367,28 @@ static void capsule_capsule(const shape *a, xform xa, const shape *b, xform xb, 
 
 /* ---- polytope against polytope ----------------------------------------------- */
 
-static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip, double spec, uint32_t tag, manifold *m)
+/* The true cylinder's line of support against a plane of normal n (pointing
+ * away from the plane): the two rim points deepest along -n. Returns 0 when
+ * the axis is along n (the cap lies flat: its prism face is exact). */
+static int cylinder_support_line(const shape *cyl, xform x, vec3 n, clip_vertex out[2])
+{
+    vec3 axis = q_rotate(x.q, v3(0, 0, 1));
+    vec3 radial = v3_madd(v3_neg(n), v3_dot(n, axis), axis); /* -n without its axial part */
+    if (v3_len2(radial) < 1e-12) return 0;
+    radial = v3_normalize(radial);
+    for (int i = 0; i < 2; i++) {
+        out[i].p = v3_add(v3_madd(x.p, i ? cyl->half_height : -cyl->half_height, axis), v3_scale(radial, cyl->radius));
+        out[i].id = 0x40u + (uint32_t)i; /* apart from the prism's vertex ids (< 2 CYL_SIDES) */
+    }
+    return 1;
+}
+
+/* Incident face clipped against reference face rf. inc_cyl: the incident
+ * shape when it is a cylinder (its round side then touches along the true
+ * line of support, not along a prism facet, which would let it settle onto
+ * the facet: roll up to 11 degrees and away), else NULL. */
+static void poly_face_contact(const poly *ref, int rf, const poly *inc, const shape *inc_cyl, xform inc_x, int flip,
+                              double spec, uint32_t tag, manifold *m)
 {
     vec3 n = ref->fn[rf];
     /* incident face: the most anti-parallel */
@@ -385,6 +406,8 @@ static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip
         buf1[i].p = inc->v[vi];
         buf1[i].id = (uint32_t)(vi & 0x7f);
     }
+    int segment = inc_cyl && inf < CYL_SIDES && cylinder_support_line(inc_cyl, inc_x, n, buf1);
+    if (segment) nbuf = 2;
     clip_vertex *in = buf1, *out = buf2;
     int rc = ref->fcount[rf];
     /* parallel faces (a stack): a vertex just outside a side plane is as deep
@@ -395,6 +418,7 @@ static void poly_face_contact(const poly *ref, int rf, const poly *inc, int flip
         vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
         if (nbuf + 1 > CLIP_MAX) break;
         nbuf = clip_polygon(in, nbuf, side, v3_dot(side, a) + tol, (uint32_t)(e & 0xff), out);
+        if (segment && nbuf > 2) nbuf = 2; /* a segment clipped as a closed polygon repeats a point */
         clip_vertex *t = in; in = out; out = t;
     }
     manifold_point cand[CLIP_MAX];
@@ -534,8 +558,8 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
     }
     cache->feature = use_b ? fb : fa;
     cache->flip = use_b;
-    if (use_b) poly_face_contact(pb, fb, pa, 1, spec, 0x20000000u, m);
-    else poly_face_contact(pa, fa, pb, 0, spec, 0, m);
+    if (use_b) poly_face_contact(pb, fb, pa, sa->type == SHAPE_CYLINDER ? sa : NULL, xa, 1, spec, 0x20000000u, m);
+    else poly_face_contact(pa, fa, pb, sb->type == SHAPE_CYLINDER ? sb : NULL, xb, 0, spec, 0, m);
 }
 
 /* Box-box: the 15-axis separating-axis test in A's frame (closed forms, no
@@ -612,8 +636,8 @@ static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double
     poly_from_box(&pb, sb->half_extents, xb);
     cache->feature = use_b ? fb : fa;
     cache->flip = use_b;
-    if (use_b) poly_face_contact(&pb, fb, &pa, 1, spec, 0x20000000u, m);
-    else poly_face_contact(&pa, fa, &pb, 0, spec, 0, m);
+    if (use_b) poly_face_contact(&pb, fb, &pa, NULL, xa, 1, spec, 0x20000000u, m);
+    else poly_face_contact(&pa, fa, &pb, NULL, xb, 0, spec, 0, m);
 }
 
 /* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */
