@@ -2,12 +2,12 @@
  * passes over batches of four independent manifolds, one vector instruction
  * doing the work of four scalar ones (the passes are bound by arithmetic:
  * interleaving four manifolds in scalar code made the solve pass about 1.3x
- * faster, AVX2 vectors about 2.4x). Greedy graph colouring puts manifolds that share no moving
- * body in one colour; within a colour, manifolds with the same number of
- * points are packed four to a batch, field by field. Each manifold is still
- * solved point by point exactly as in solver.c; only the order between
- * manifolds becomes colour by colour. Manifolds beyond the last colour keep
- * the scalar pass. */
+ * faster, AVX2 vectors about 2.4x). Greedy graph colouring puts manifolds
+ * that share no moving body in one colour; within a colour, manifolds with
+ * the same number of points are packed four to a batch, field by field. Each
+ * manifold is still solved point by point exactly as in solver.c; only the
+ * order between manifolds becomes colour by colour. Manifolds beyond the last
+ * colour keep the scalar pass. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
