@@ -550,10 +550,13 @@ int world_solve(carom_world *w, double dt)
             cd->state[j].tangent_impulse[0] = p->tangent_impulse[0];
             cd->state[j].tangent_impulse[1] = p->tangent_impulse[1];
             total += p->total_normal_impulse;
-            tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;
             if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
         }
         if (approach > def->restitution_threshold && total > 0.0) {
+            for (int j = 0; j < con->count; j++) {
+                const constraint_point *p = &con->p[j];
+                tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;
+            }
             carom_contact_event e;
             memset(&e, 0, sizeof e);
             e.type = CAROM_EVENT_HIT;
