@@ -8,9 +8,12 @@ int clip_polygon(const clip_vertex *in, int n, vec3 plane_n, double plane_d, uin
     /* Sutherland-Hodgman against one plane: keep dot(plane_n, p) <= plane_d */
     int m = 0;
     if (n == 0) return 0;
+    /* each vertex's distance once: it is b's for one edge and a's for the next */
+    double d0 = v3_dot(plane_n, in[0].p) - plane_d, da = d0;
     for (int i = 0; i < n; i++) {
-        const clip_vertex *a = &in[i], *b = &in[(i + 1) % n];
-        double da = v3_dot(plane_n, a->p) - plane_d, db = v3_dot(plane_n, b->p) - plane_d;
+        int last = i + 1 == n;
+        const clip_vertex *a = &in[i], *b = last ? &in[0] : &in[i + 1];
+        double db = last ? d0 : v3_dot(plane_n, b->p) - plane_d;
         if (da <= 0) out[m++] = *a;
         if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
             double t = da / (da - db);
@@ -19,7 +22,7 @@ int clip_polygon(const clip_vertex *in, int n, vec3 plane_n, double plane_d, uin
             out[m].id = (a->id & 0xffu) | 0x80u | (edge_tag << 8);
             m++;
         }
-        if (n == 1) break;
+        da = db;
     }
     return m;
 }

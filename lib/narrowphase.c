@@ -73,19 +73,26 @@ static void poly_from_hull(poly *p, const hull *h, xform x)
     poly_finish(p);
 }
 
+/* A box's vertices: vertex i has +x when bit 0 is set, +y bit 1, +z bit 2.
+ * Faces in the order +x -x +y -y +z -z, each counter-clockwise from outside. */
+static const int box_faces[6][4] = {{1, 3, 7, 5}, {0, 4, 6, 2}, {2, 6, 7, 3}, {0, 1, 5, 4}, {4, 5, 7, 6}, {0, 2, 3, 1}};
+static const double box_normals[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+
+static inline vec3 box_vertex(vec3 he, const xform *x, int i)
+{
+    return xf_point(*x, v3((i & 1) ? he.x : -he.x, (i & 2) ? he.y : -he.y, (i & 4) ? he.z : -he.z));
+}
+
 static void poly_from_box(poly *p, vec3 he, xform x)
 {
-    static const int faces[6][4] = {{1, 3, 7, 5}, {0, 4, 6, 2}, {2, 6, 7, 3}, {0, 1, 5, 4}, {4, 5, 7, 6}, {0, 2, 3, 1}};
-    static const double normals[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     static const int edges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
     p->nv = 8; p->nf = 6; p->ne = 12;
-    for (int i = 0; i < 8; i++)
-        p->v[i] = xf_point(x, v3((i & 1) ? he.x : -he.x, (i & 2) ? he.y : -he.y, (i & 4) ? he.z : -he.z));
+    for (int i = 0; i < 8; i++) p->v[i] = box_vertex(he, &x, i);
     for (int f = 0; f < 6; f++) {
-        p->fn[f] = q_rotate(x.q, v3(normals[f][0], normals[f][1], normals[f][2]));
+        p->fn[f] = q_rotate(x.q, v3(box_normals[f][0], box_normals[f][1], box_normals[f][2]));
         p->ffirst[f] = 4 * f;
         p->fcount[f] = 4;
-        for (int j = 0; j < 4; j++) p->fv[4 * f + j] = faces[f][j];
+        for (int j = 0; j < 4; j++) p->fv[4 * f + j] = box_faces[f][j];
     }
     for (int i = 0; i < 12; i++) { p->e[i][0] = edges[i][0]; p->e[i][1] = edges[i][1]; }
     poly_finish(p);
@@ -562,9 +569,73 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
     else poly_face_contact(pa, fa, pb, sb->type == SHAPE_CYLINDER ? sb : NULL, xb, 0, spec, 0, m);
 }
 
+/* poly_face_contact for a box face against a box, without building either
+ * polytope: only the reference face's 4 vertices and the incident face's 4.
+ * Every value is computed by the same operations as through poly_from_box and
+ * poly_face_contact (same normal, vertices, side planes, clip order and ids),
+ * so the manifold is bit for bit the same. iax: the incident box's axes
+ * (q_rotate of the unit axes, i.e. its +x +y +z face normals). */
+static void box_face_contact(vec3 rh, const xform *rx, int rf, vec3 ih, const xform *ix, const vec3 iax[3], int flip,
+                             double spec, uint32_t tag, manifold *m)
+{
+    /* not +-axis: a -axis face's q_rotate can differ from the negated axis in
+     * the sign of a zero component, and the solver's tangent basis reads it */
+    vec3 n = q_rotate(rx->q, v3(box_normals[rf][0], box_normals[rf][1], box_normals[rf][2]));
+    /* incident face: the most anti-parallel, in face order (+x -x +y -y +z -z);
+     * q_rotate is odd in v, so a -axis face's dot is exactly the +axis one negated */
+    int inf = 0;
+    double best = 1e300;
+    for (int k = 0; k < 3; k++) {
+        double dd = v3_dot(iax[k], n);
+        if (dd < best) { best = dd; inf = 2 * k; }
+        if (-dd < best) { best = -dd; inf = 2 * k + 1; }
+    }
+    clip_vertex buf1[CLIP_MAX], buf2[CLIP_MAX];
+    for (int i = 0; i < 4; i++) {
+        int vi = box_faces[inf][i];
+        buf1[i].p = box_vertex(ih, ix, vi);
+        buf1[i].id = (uint32_t)vi;
+    }
+    /* the reference face's side planes (outward), as poly_face_contact makes them */
+    double tol = 1.0 + best < 1e-8 ? CLIP_TOLERANCE : 0.0; /* parallel faces: see poly_face_contact */
+    vec3 rv[4], side[4];
+    double sd[4];
+    for (int i = 0; i < 4; i++) rv[i] = box_vertex(rh, rx, box_faces[rf][i]);
+    for (int e = 0; e < 4; e++) {
+        side[e] = v3_normalize(v3_cross(v3_sub(rv[(e + 1) & 3], rv[e]), n));
+        sd[e] = v3_dot(side[e], rv[e]) + tol;
+    }
+    double fd = v3_dot(n, rv[0]);
+    clip_vertex *in = buf1, *out = buf2;
+    int nbuf = 4;
+    for (int e = 0; e < 4 && nbuf > 0; e++) {
+        /* a plane with every point inside: clip_polygon would return the polygon as it is */
+        int cut = 0;
+        for (int i = 0; i < nbuf; i++) cut |= !(v3_dot(side[e], in[i].p) - sd[e] <= 0);
+        if (!cut) continue;
+        if (nbuf + 1 > CLIP_MAX) break;
+        nbuf = clip_polygon(in, nbuf, side[e], sd[e], (uint32_t)e, out);
+        clip_vertex *t = in; in = out; out = t;
+    }
+    manifold_point cand[CLIP_MAX];
+    int nc = 0;
+    for (int i = 0; i < nbuf; i++) {
+        double sep = v3_dot(n, in[i].p) - fd;
+        if (sep >= spec) continue;
+        cand[nc].point = v3_madd(in[i].p, -0.5 * sep, n);
+        cand[nc].separation = sep;
+        cand[nc].id = tag | ((uint32_t)rf << 20) | ((uint32_t)inf << 16) | (in[i].id & 0xffffu);
+        nc++;
+    }
+    nc = manifold_reduce(cand, nc, n);
+    m->normal = flip ? v3_neg(n) : n;
+    for (int i = 0; i < nc; i++) m->points[i] = cand[i];
+    m->count = nc;
+}
+
 /* Box-box: the 15-axis separating-axis test in A's frame (closed forms, no
- * vertex loops); face contacts are clipped, the rare edge-edge winner goes to
- * the general polytope path. */
+ * vertex loops); a face contact clips the incident face to the reference face
+ * (box_face_contact), an edge-edge winner gives one point between the edges. */
 static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double spec, collide_cache *cache,
                     manifold *m)
 {
@@ -631,13 +702,10 @@ static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double
     }
     int use_b = sb_best > sa_best + KEEP_TOLERANCE;
     if (cache->feature >= 0 && fabs(sb_best - sa_best) <= KEEP_TOLERANCE) use_b = cache->flip;
-    poly pa, pb;
-    poly_from_box(&pa, sa->half_extents, xa);
-    poly_from_box(&pb, sb->half_extents, xb);
     cache->feature = use_b ? fb : fa;
     cache->flip = use_b;
-    if (use_b) poly_face_contact(&pb, fb, &pa, NULL, xa, 1, spec, 0x20000000u, m);
-    else poly_face_contact(&pa, fa, &pb, NULL, xb, 0, spec, 0, m);
+    if (use_b) box_face_contact(sb->half_extents, &xb, fb, sa->half_extents, &xa, ax, 1, spec, 0x20000000u, m);
+    else box_face_contact(sa->half_extents, &xa, fa, sb->half_extents, &xb, bx, 0, spec, 0, m);
 }
 
 /* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */

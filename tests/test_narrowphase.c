@@ -771,6 +771,86 @@ static void test_feature_ids_survive_jitter(void **state)
     }
 }
 
+/* Box-box face contacts pinned to the ids, order, separations and reference
+ * choice the general polytope clipper (poly_from_box + poly_face_contact)
+ * gave before the box path clipped boxes directly: the contact cache matches
+ * points by these ids across steps, so a change here loses warm starts. */
+typedef struct pinned_point { uint32_t id; double sep; vec3 p; } pinned_point;
+
+static void check_pinned(const char *name, const shape *a, xform xa, const shape *b, xform xb, int feature, int flip,
+                         vec3 normal, int want_feature, int want_flip, int n, const pinned_point *want)
+{
+    collide_cache c;
+    memset(&c, 0, sizeof c);
+    c.feature = feature;
+    c.flip = flip;
+    manifold m;
+    int got = collide(a, xa, b, xb, 0.02, &c, &m);
+    if (got != n || c.feature != want_feature || c.flip != want_flip) {
+        print_error("%s: %d points feature %d flip %d, expected %d, %d, %d\n", name, got, c.feature, c.flip, n,
+                    want_feature, want_flip);
+        fail();
+    }
+    NEAR_V(m.normal, normal, 1e-12);
+    for (int i = 0; i < n; i++) {
+        if (m.points[i].id != want[i].id) {
+            print_error("%s: point %d id 0x%08x, expected 0x%08x\n", name, i, (unsigned)m.points[i].id,
+                        (unsigned)want[i].id);
+            fail();
+        }
+        NEAR(m.points[i].separation, want[i].sep, 1e-12);
+        NEAR_V(m.points[i].point, want[i].p, 1e-12);
+    }
+}
+
+static void test_box_box_pinned_ids(void **state)
+{
+    (void)state;
+    shape b = box(0.5, 0.5, 0.5), s = box(0.2, 0.3, 0.1), big = box(1, 1, 0.25);
+    xform o = at(0, 0, 0);
+    /* aligned stack (parallel faces: the clip tolerance keeps the corners) */
+    static const pinned_point aligned[4] = {{0x00450000u, 0, {-0.5, -0.5, 1}}, {0x00450002u, 0, {-0.5, 0.5, 1}},
+                                            {0x00450003u, 0, {0.5, 0.5, 1}}, {0x00450001u, 0, {0.5, -0.5, 1}}};
+    check_pinned("aligned", &b, at(0, 0, 0.5), &b, at(0, 0, 1.5), -1, 0, v3(0, 0, 1), 4, 0, 4, aligned);
+    /* turned 45 degrees: eight clipped points reduced to four */
+    static const pinned_point rot45[4] = {
+        {0x00450080u, -0.010000000000000009, {-0.20660678118654752, -0.50049999999999994, 0.995}},
+        {0x00450283u, -0.010000000000000009, {0.20660678118654749, 0.50049999999999994, 0.995}},
+        {0x00450382u, -0.010000000000000009, {-0.50049999999999994, 0.20660678118654749, 0.995}},
+        {0x00450183u, -0.010000000000000009, {0.50049999999999994, 0.20660678118654752, 0.995}}};
+    xform x45 = {v3(0, 0, 1.49), q_axis_angle(v3(0, 0, 1), 0.7853981633974483)};
+    check_pinned("rot45", &b, at(0, 0, 0.5), &b, x45, -1, 0, v3(0, 0, 1), 4, 0, 4, rot45);
+    /* a small tilted box over a big box's corner: b's face is the reference */
+    static const pinned_point overhang[4] = {
+        {0x20540084u, -0.0023972159463905851, {0.74926613107914186, -0.99999662799683908, 0.24880144983529159}},
+        {0x20540005u, -0.0047564419956154236, {0.99997762163784076, -0.99999330943152287, 0.24762189370304563}},
+        {0x20540185u, -0.0036301033537709526, {0.99998292089599727, -0.59962798656403271, 0.24818503586248802}},
+        {0x20540187u, -0.0012650691187584551, {0.74851374390737224, -0.60010111544984879, 0.24936749594756433}}};
+    xform xo = {v3(0.95, -0.9, 0.25 + 0.1 - 0.004), q_axis_angle(v3(0.3, 1, 0.2), 0.01)};
+    check_pinned("overhang", &big, o, &s, xo, -1, 0,
+                 v3(0.0094097067429413251, -0.0028132660855664949, 0.99995177031342053), 5, 1, 4, overhang);
+    /* a box tipped 0.1 rad on its edge: b's face, two points */
+    static const pinned_point tipped[2] = {{0x20450003u, -0.0029999999999999749, {0.48901749139092232, 0.5, 0.2485}},
+                                           {0x20450001u, -0.0029999999999999749, {0.48901749139092232, -0.1, 0.2485}}};
+    xform xt = {v3(0.3, 0.2, 0.25 + 0.1 * cos(0.1) + 0.2 * sin(0.1) - 0.003), q_axis_angle(v3(0, 1, 0), 0.1)};
+    check_pinned("tipped", &s, xt, &big, o, -1, 0, v3(0, 0, -1), 4, 1, 2, tipped);
+    /* nearly parallel faces: last step's reference (b's) is kept, else a's is taken */
+    static const pinned_point keep_b[4] = {
+        {0x20450000u, -0.0020599979996000495, {-0.1, -0.24997999400013332, 0.24897000100019998}},
+        {0x20450002u, -0.0019399980004000117, {-0.1, 0.35001999399986666, 0.24903000099979999}},
+        {0x20450003u, -0.0019399980004000117, {0.3, 0.35001999399986666, 0.24903000099979999}},
+        {0x20450001u, -0.0020599979996000495, {0.3, -0.24997999400013332, 0.24897000100019998}}};
+    static const pinned_point take_a[4] = {
+        {0x00540384u, -0.0020599980408000096, {0.3, -0.24998019999993598, 0.24897000100019998}},
+        {0x00540285u, -0.0019399980392000027, {0.3, 0.350019800000064, 0.24903000099979997}},
+        {0x00540187u, -0.0019399980392000027, {-0.1, 0.350019800000064, 0.24903000099979997}},
+        {0x00540387u, -0.0020599980408000096, {-0.1, -0.24998019999993598, 0.24897000100019998}}};
+    xform xk = {v3(0.1, 0.05, 0.25 + 0.1 - 0.002), q_axis_angle(v3(1, 0, 0), 2e-4)};
+    check_pinned("keep_b", &s, xk, &big, o, 4, 1, v3(0, 0, -1), 4, 1, 4, keep_b);
+    check_pinned("take_a", &s, xk, &big, o, -1, 0, v3(0, 0.00019999999866666669, -0.99999998000000012), 5, 0, 4,
+                 take_a);
+}
+
 /* ---- 5. every pair of shape types stays finite ----------------------------------- */
 
 static void test_every_pair_is_finite(void **state)
@@ -847,6 +927,7 @@ int main(void)
         cmocka_unit_test(test_random_box_box_against_brute_force),
         cmocka_unit_test(test_hull_boxes_agree_with_box_path),
         cmocka_unit_test(test_feature_ids_survive_jitter),
+        cmocka_unit_test(test_box_box_pinned_ids),
         cmocka_unit_test(test_every_pair_is_finite),
         cmocka_unit_test(test_non_finite_poses_give_no_contact),
     };
