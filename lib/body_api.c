@@ -6,12 +6,20 @@
 #include "array.h"
 #include "world.h"
 #include "narrowphase.h"
+#include "ranges.h"
 
-#define MAX_COORDINATE 1e12
+#define MAX_COORDINATE RANGE_COORDINATE_MAX
 
 static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
 static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
 static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+static int length_ok(double x) { return x >= RANGE_LENGTH_MIN && x <= RANGE_LENGTH_MAX; }
+static double len_c(carom_vec3 v) { return sqrt(v.x * v.x + v.y * v.y + v.z * v.z); } /* inf when huge */
+static int normal_ok(carom_vec3 n)
+{
+    double l = len_c(n);
+    return finite_c(n) && isfinite(l) && l >= RANGE_NORMAL_MIN;
+}
 static int quat_ok(carom_quat q)
 {
     double l2 = q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;
@@ -82,39 +90,67 @@ static void refresh_proxy(carom_world *w, int slot)
 
 /* ---- validation of a body def ------------------------------------------------ */
 
+#define LENGTH_RANGE "[1e-6, 1e6] m"
+
 static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_type type)
 {
+#define FAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
     switch (sd->type) {
     case CAROM_SHAPE_SPHERE:
-        if (!(isfinite(sd->radius) && sd->radius > 0))
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: sphere radius must be positive and finite (got %g)", sd->radius), 0;
+        if (!length_ok(sd->radius)) FAIL("body_create: sphere radius %g is outside " LENGTH_RANGE, sd->radius);
         break;
     case CAROM_SHAPE_BOX:
-        if (!(finite_c(sd->half_extents) && sd->half_extents.x > 0 && sd->half_extents.y > 0 && sd->half_extents.z > 0))
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: box half extents must be positive and finite"), 0;
+        if (!length_ok(sd->half_extents.x) || !length_ok(sd->half_extents.y) || !length_ok(sd->half_extents.z))
+            FAIL("body_create: box half extents (%g, %g, %g) must each be in " LENGTH_RANGE, sd->half_extents.x,
+                 sd->half_extents.y, sd->half_extents.z);
         break;
     case CAROM_SHAPE_CAPSULE:
-    case CAROM_SHAPE_CYLINDER:
-        if (!(isfinite(sd->radius) && sd->radius > 0 && isfinite(sd->half_height) && sd->half_height > 0))
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s radius and half_height must be positive and finite",
-                              sd->type == CAROM_SHAPE_CAPSULE ? "capsule" : "cylinder"), 0;
+    case CAROM_SHAPE_CYLINDER: {
+        const char *name = sd->type == CAROM_SHAPE_CAPSULE ? "capsule" : "cylinder";
+        if (!length_ok(sd->radius)) FAIL("body_create: %s radius %g is outside " LENGTH_RANGE, name, sd->radius);
+        if (!length_ok(sd->half_height))
+            FAIL("body_create: %s half_height %g is outside " LENGTH_RANGE, name, sd->half_height);
         break;
+    }
     case CAROM_SHAPE_HULL:
         if (!sd->points || sd->point_count < 4 || sd->point_count > 100000)
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a hull needs 4..100000 points (got %d%s)",
-                              sd->point_count, sd->points ? "" : ", NULL array"), 0;
+            FAIL("body_create: a hull needs 4..100000 points (got %d%s)", sd->point_count, sd->points ? "" : ", NULL array");
+        for (int i = 0; i < 3 * sd->point_count; i++)
+            if (!(fabs(sd->points[i]) <= RANGE_LENGTH_MAX))
+                FAIL("body_create: hull point %d has coordinate %g; each must be finite with |c| <= 1e6 m", i / 3,
+                     sd->points[i]);
         break;
     case CAROM_SHAPE_PLANE:
-        if (type != CAROM_BODY_STATIC)
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a plane can only be a static body"), 0;
-        if (!finite_c(sd->normal) || !isfinite(sd->offset) || v3_len(to_v3(sd->normal)) < 1e-12)
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: plane normal must be finite and non-zero, offset finite"), 0;
+        if (type != CAROM_BODY_STATIC) FAIL("body_create: a plane can only be a static body");
+        if (!normal_ok(sd->normal)) FAIL("body_create: plane normal must be finite with length >= 1e-12");
+        if (!(fabs(sd->offset / len_c(sd->normal)) <= RANGE_COORDINATE_MAX))
+            FAIL("body_create: plane offset %g is outside [-1e12, 1e12] m", sd->offset / len_c(sd->normal));
         break;
     default:
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: unknown shape type %d", (int)sd->type), 0;
+        FAIL("body_create: unknown shape type %d", (int)sd->type);
     }
+#undef FAIL
     return 1;
 }
+
+/* A dynamic body's mass and inertia (fn names the caller): inside the ranges
+ * the solver's products and inverses stay finite. The principal moments are
+ * bounded through the trace (>= the largest) and det / trace^2 (<= the smallest). */
+static int check_mass_props(const carom_world *w, const mass_props *mp, const char *fn)
+{
+    if (!(mp->mass >= RANGE_MASS_MIN && mp->mass <= RANGE_MASS_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: mass %g kg is outside [1e-9, 1e15] kg", fn, mp->mass), 0;
+    double trace = mp->inertia.c0.x + mp->inertia.c1.y + mp->inertia.c2.z;
+    double smallest = m3_det(mp->inertia) / (trace * trace);
+    if (!(trace <= RANGE_INERTIA_MAX && smallest >= RANGE_INERTIA_MIN))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "%s: principal moments of inertia in [%g, %g] kg m^2 must lie within [1e-24, 1e30] "
+                          "(the body is too small, too thin or too light for its mass)", fn, smallest, trace), 0;
+    return 1;
+}
+
+/* |v| within the world's clamp (max_linear_speed / max_angular_speed). */
+static int speed_ok(carom_vec3 v, double max) { return finite_c(v) && len_c(v) <= max; }
 
 static int check_body_def(carom_world *w, const carom_body_def *d)
 {
@@ -123,22 +159,36 @@ static int check_body_def(carom_world *w, const carom_body_def *d)
         FAIL("body_create: unknown body type %d", (int)d->type);
     if (!finite_c(d->position)) FAIL("body_create: position must be finite");
     if (fabs(d->position.x) > MAX_COORDINATE || fabs(d->position.y) > MAX_COORDINATE || fabs(d->position.z) > MAX_COORDINATE)
-        FAIL("body_create: position beyond 1e12 m");
+        FAIL("body_create: position (%g, %g, %g) is beyond 1e12 m", d->position.x, d->position.y, d->position.z);
     if (!quat_ok(d->orientation)) FAIL("body_create: orientation must be a finite unit quaternion {w,x,y,z}");
     if (!finite_c(d->linear_velocity)) FAIL("body_create: linear velocity must be finite");
     if (!finite_c(d->angular_velocity)) FAIL("body_create: angular velocity must be finite");
+    if (!speed_ok(d->linear_velocity, w->def.max_linear_speed))
+        FAIL("body_create: linear speed %g m/s is above the world's max_linear_speed %g m/s", len_c(d->linear_velocity),
+             w->def.max_linear_speed);
+    if (!speed_ok(d->angular_velocity, w->def.max_angular_speed))
+        FAIL("body_create: angular speed %g rad/s is above the world's max_angular_speed %g rad/s",
+             len_c(d->angular_velocity), w->def.max_angular_speed);
     if (!(isfinite(d->mass) && d->mass >= 0)) FAIL("body_create: mass must be finite and >= 0 (got %g)", d->mass);
+    if (d->mass > 0 && !(d->mass >= RANGE_MASS_MIN && d->mass <= RANGE_MASS_MAX))
+        FAIL("body_create: mass %g kg is outside [1e-9, 1e15] kg", d->mass);
     if (!(isfinite(d->density) && d->density >= 0)) FAIL("body_create: density must be finite and >= 0 (got %g)", d->density);
+    if (d->density != 0 && !(d->density >= RANGE_DENSITY_MIN && d->density <= RANGE_DENSITY_MAX))
+        FAIL("body_create: density %g kg/m^3 is outside [1e-6, 1e9] kg/m^3 (or 0: unused)", d->density);
     if (d->type == CAROM_BODY_DYNAMIC && d->mass == 0 && d->density == 0)
         FAIL("body_create: a dynamic body needs mass > 0 or density > 0");
-    if (!(isfinite(d->friction) && d->friction >= 0)) FAIL("body_create: friction must be finite and >= 0");
+    if (!(isfinite(d->friction) && d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX))
+        FAIL("body_create: friction %g is outside [0, 1000]", d->friction);
     if (!(isfinite(d->restitution) && d->restitution >= 0 && d->restitution <= 1))
         FAIL("body_create: restitution must be in [0, 1]");
-    if (!(isfinite(d->linear_damping) && d->linear_damping >= 0)) FAIL("body_create: linear damping must be finite and >= 0");
-    if (!(isfinite(d->angular_damping) && d->angular_damping >= 0)) FAIL("body_create: angular damping must be finite and >= 0");
-    if (!isfinite(d->gravity_scale)) FAIL("body_create: gravity scale must be finite");
-    if (d->lock_to_plane && (!finite_c(d->plane_normal) || v3_len(to_v3(d->plane_normal)) < 1e-12))
-        FAIL("body_create: plane_normal must be finite and non-zero");
+    if (!(isfinite(d->linear_damping) && d->linear_damping >= 0 && d->linear_damping <= RANGE_DAMPING_MAX))
+        FAIL("body_create: linear damping %g is outside [0, 1e6] 1/s", d->linear_damping);
+    if (!(isfinite(d->angular_damping) && d->angular_damping >= 0 && d->angular_damping <= RANGE_DAMPING_MAX))
+        FAIL("body_create: angular damping %g is outside [0, 1e6] 1/s", d->angular_damping);
+    if (!(fabs(d->gravity_scale) <= RANGE_GRAVITY_SCALE_MAX))
+        FAIL("body_create: gravity scale %g is outside [-1e4, 1e4]", d->gravity_scale);
+    if (d->lock_to_plane && !normal_ok(d->plane_normal))
+        FAIL("body_create: plane_normal must be finite with length >= 1e-12");
 #undef FAIL
     return check_shape(w, &d->shape, d->type);
 }
@@ -198,9 +248,8 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     mass_props mp = {0, {0, 0, 0}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
     if (sh.type != SHAPE_PLANE)
         mp = d.mass > 0 ? shape_mass_from_mass(&sh, d.mass) : shape_mass_from_density(&sh, d.density);
-    if (d.type == CAROM_BODY_DYNAMIC && !(mp.mass > 0 && isfinite(mp.mass))) {
+    if (d.type == CAROM_BODY_DYNAMIC && !check_mass_props(w, &mp, "body_create")) {
         hull_free(sh.hull);
-        world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: dynamic body mass is not positive (got %g)", mp.mass);
         return null_id;
     }
     if (!body_store_reserve(&w->bodies)) {
@@ -417,7 +466,7 @@ CAROM_API carom_status carom_body_set_position(carom_world *w, carom_body_id id,
     GET_SLOT(w, id, "body_set_position");
     REQUIRE_UNLOCKED(w, "body_set_position");
     if (!finite_c(p) || fabs(p.x) > MAX_COORDINATE || fabs(p.y) > MAX_COORDINATE || fabs(p.z) > MAX_COORDINATE)
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_position: position must be finite (|x| <= 1e12)");
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_position: position (%g, %g, %g) must be finite with |x| <= 1e12 m", p.x, p.y, p.z);
     body_store *s = &w->bodies;
     s->center[slot] = v3_add(to_v3(p), q_rotate(s->rotation[slot], s->local_center[slot]));
     if (s->flags[slot] & BODY_LOCK_PLANE) s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
@@ -446,6 +495,10 @@ CAROM_API carom_status carom_body_set_linear_velocity(carom_world *w, carom_body
     GET_SLOT(w, id, "body_set_linear_velocity");
     REQUIRE_UNLOCKED(w, "body_set_linear_velocity");
     if (!finite_c(v)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_linear_velocity: velocity must be finite");
+    if (!speed_ok(v, w->def.max_linear_speed))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "body_set_linear_velocity: speed %g m/s is above the world's max_linear_speed %g m/s", len_c(v),
+                          w->def.max_linear_speed);
     body_store *s = &w->bodies;
     if (s->type[slot] == CAROM_BODY_STATIC)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_linear_velocity: a static body cannot move");
@@ -461,6 +514,10 @@ CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_bod
     GET_SLOT(w, id, "body_set_angular_velocity");
     REQUIRE_UNLOCKED(w, "body_set_angular_velocity");
     if (!finite_c(av)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_angular_velocity: must be finite");
+    if (!speed_ok(av, w->def.max_angular_speed))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "body_set_angular_velocity: speed %g rad/s is above the world's max_angular_speed %g rad/s",
+                          len_c(av), w->def.max_angular_speed);
     body_store *s = &w->bodies;
     if (s->type[slot] == CAROM_BODY_STATIC)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_angular_velocity: a static body cannot move");
@@ -481,6 +538,7 @@ CAROM_API carom_status carom_body_set_mass(carom_world *w, carom_body_id id, dou
     if (s->type[slot] != CAROM_BODY_DYNAMIC)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_mass: only dynamic bodies have mass");
     mass_props mp = shape_mass_from_mass(&s->shapes[slot], mass);
+    if (!check_mass_props(w, &mp, "body_set_mass")) return CAROM_ERROR_INVALID_ARGUMENT;
     vec3 origin = body_origin(s, slot);
     s->mass[slot] = mp.mass;
     s->inv_mass[slot] = 1.0 / mp.mass;
@@ -503,8 +561,11 @@ CAROM_API carom_status carom_body_set_type(carom_world *w, carom_body_id id, car
     if (s->type[slot] == (int)type) return CAROM_OK;
     if (s->shapes[slot].type == SHAPE_PLANE)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a plane must stay static");
-    if (type == CAROM_BODY_DYNAMIC && !(s->mass[slot] > 0))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: body has no mass");
+    if (type == CAROM_BODY_DYNAMIC) {
+        mass_props mp = {s->mass[slot], s->local_center[slot], s->inertia_local[slot]};
+        if (!(s->mass[slot] > 0)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: body has no mass");
+        if (!check_mass_props(w, &mp, "body_set_type")) return CAROM_ERROR_INVALID_ARGUMENT;
+    }
     int proxy = bp_create_proxy(w->bp, s->fat_box[slot], type == CAROM_BODY_STATIC, s->id_index[slot]);
     if (proxy < 0) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_set_type: out of memory");
     bp_destroy_proxy(w->bp, s->proxy[slot]);
@@ -529,8 +590,8 @@ CAROM_API carom_status carom_body_set_friction(carom_world *w, carom_body_id id,
 {
     GET_SLOT(w, id, "body_set_friction");
     REQUIRE_UNLOCKED(w, "body_set_friction");
-    if (!(isfinite(friction) && friction >= 0))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_friction: friction must be finite and >= 0");
+    if (!(isfinite(friction) && friction >= 0 && friction <= RANGE_FRICTION_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_friction: friction %g is outside [0, 1000]", friction);
     w->bodies.friction[slot] = friction;
     return CAROM_OK;
 }
@@ -549,7 +610,8 @@ CAROM_API carom_status carom_body_set_gravity_scale(carom_world *w, carom_body_i
 {
     GET_SLOT(w, id, "body_set_gravity_scale");
     REQUIRE_UNLOCKED(w, "body_set_gravity_scale");
-    if (!isfinite(scale)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_gravity_scale: must be finite");
+    if (!(fabs(scale) <= RANGE_GRAVITY_SCALE_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_gravity_scale: scale %g is outside [-1e4, 1e4]", scale);
     w->bodies.gravity_scale[slot] = scale;
     world_wake_body(w, slot);
     return CAROM_OK;
@@ -607,6 +669,14 @@ CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id
     }
     if (!v3_is_finite(nv) || !v3_is_finite(nw))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: resulting velocity is not finite");
+    if (v3_len(nv) > w->def.max_linear_speed)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "body_apply_impulse: resulting speed %g m/s is above the world's max_linear_speed %g m/s",
+                          v3_len(nv), w->def.max_linear_speed);
+    if (v3_len(nw) > w->def.max_angular_speed)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "body_apply_impulse: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s",
+                          v3_len(nw), w->def.max_angular_speed);
     s->velocity[slot] = nv;
     s->angular_velocity[slot] = nw;
     world_wake_body(w, slot);
@@ -620,7 +690,12 @@ CAROM_API carom_status carom_body_apply_force(carom_world *w, carom_body_id id, 
     if (!finite_c(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_force: force must be finite");
     body_store *s = &w->bodies;
     if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK;
-    s->force[slot] = v3_add(s->force[slot], to_v3(force));
+    vec3 total = v3_add(s->force[slot], to_v3(force));
+    if (!(v3_len(total) * s->inv_mass[slot] <= RANGE_ACCELERATION_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "body_apply_force: the body's total force %g N over its mass %g kg is above 1e9 m/s^2",
+                          v3_len(total), s->mass[slot]);
+    s->force[slot] = total;
     s->flags[slot] |= BODY_HAS_FORCE;
     world_wake_body(w, slot);
     return CAROM_OK;

@@ -20,6 +20,11 @@ void world_update_sleep(carom_world *w, double dt)
     const carom_world_def *def = &w->def;
     step_scratch *sc = &w->scratch;
     int n = s->count;
+    if (n == 0) { /* no bodies: the island arrays may not exist yet */
+        w->stats.islands = 0;
+        w->stats.awake_bodies = 0;
+        return;
+    }
     if (!def->enable_sleep) {
         for (int i = 0; i < n; i++)
             if (s->type[i] != CAROM_BODY_STATIC) { s->flags[i] |= BODY_AWAKE; s->sleep_time[i] = 0; }

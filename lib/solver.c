@@ -612,6 +612,10 @@ int world_solve(carom_world *w, double dt)
             body_update_inertia(bs, slot);
             av = m3_mulv(bs->inv_inertia_world[slot], L);
             if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));
+            if (!v3_is_finite(av)) { /* the ranges keep this finite; never let NaN through if not */
+                av = v3_zero();
+                w->stats.non_finite++;
+            }
             bs->angular_velocity[slot] = av;
         } else {
             body_update_inertia(bs, slot);

@@ -7,6 +7,7 @@
 #include <time.h>
 #include "array.h"
 #include "world.h"
+#include "ranges.h"
 
 CAROM_API const char *carom_version(void) { return "1.0.0"; }
 
@@ -66,6 +67,8 @@ static int def_validate(const carom_world_def *d, char *msg, size_t n)
 {
 #define REQUIRE(cond, ...) do { if (!(cond)) { snprintf(msg, n, __VA_ARGS__); return 0; } } while (0)
     REQUIRE(finite3(d->gravity), "gravity must be finite");
+    REQUIRE(sqrt(d->gravity.x * d->gravity.x + d->gravity.y * d->gravity.y + d->gravity.z * d->gravity.z) <= RANGE_GRAVITY_MAX,
+            "|gravity| must be at most 1e4 m/s^2 (got (%g, %g, %g))", d->gravity.x, d->gravity.y, d->gravity.z);
     REQUIRE(d->substeps >= 1 && d->substeps <= 64, "substeps must be in 1..64 (got %d)", d->substeps);
     REQUIRE(d->iterations >= 1 && d->iterations <= 256, "iterations must be in 1..256 (got %d)", d->iterations);
     REQUIRE(d->relax_iterations >= 0 && d->relax_iterations <= 256, "relax_iterations must be in 0..256 (got %d)",
@@ -74,24 +77,27 @@ static int def_validate(const carom_world_def *d, char *msg, size_t n)
             "position_correction must be SOFT, BAUMGARTE or NONE");
     REQUIRE(d->contact_model == CAROM_CONTACT_IMPULSE || d->contact_model == CAROM_CONTACT_PENALTY,
             "contact_model must be IMPULSE or PENALTY");
-    REQUIRE(isfinite(d->restitution_threshold) && d->restitution_threshold >= 0,
-            "restitution_threshold must be finite and >= 0");
-    REQUIRE(isfinite(d->contact_hertz) && d->contact_hertz > 0, "contact_hertz must be finite and > 0");
-    REQUIRE(isfinite(d->contact_damping_ratio) && d->contact_damping_ratio >= 0,
-            "contact_damping_ratio must be finite and >= 0");
-    REQUIRE(isfinite(d->contact_push_max_velocity) && d->contact_push_max_velocity > 0,
-            "contact_push_max_velocity must be finite and > 0");
+    REQUIRE(d->restitution_threshold >= 0 && d->restitution_threshold <= RANGE_SPEED_MAX,
+            "restitution_threshold must be in [0, 1e9] m/s (got %g)", d->restitution_threshold);
+    REQUIRE(d->contact_hertz >= RANGE_HERTZ_MIN && d->contact_hertz <= RANGE_HERTZ_MAX,
+            "contact_hertz must be in [1e-3, 1e6] (got %g)", d->contact_hertz);
+    REQUIRE(d->contact_damping_ratio >= 0 && d->contact_damping_ratio <= RANGE_RATIO_MAX,
+            "contact_damping_ratio must be in [0, 1e6] (got %g)", d->contact_damping_ratio);
+    REQUIRE(d->contact_push_max_velocity > 0 && d->contact_push_max_velocity <= RANGE_SPEED_MAX,
+            "contact_push_max_velocity must be in (0, 1e9] m/s (got %g)", d->contact_push_max_velocity);
     REQUIRE(isfinite(d->baumgarte) && d->baumgarte >= 0 && d->baumgarte <= 1, "baumgarte must be in [0, 1]");
     REQUIRE(isfinite(d->linear_slop) && d->linear_slop >= 0 && d->linear_slop < 1, "linear_slop must be in [0, 1)");
     REQUIRE(isfinite(d->speculative_distance) && d->speculative_distance >= 0 && d->speculative_distance < 10,
             "speculative_distance must be in [0, 10)");
-    REQUIRE(isfinite(d->penalty_stiffness) && d->penalty_stiffness >= 0, "penalty_stiffness must be finite and >= 0");
-    REQUIRE(isfinite(d->penalty_damping) && d->penalty_damping >= 0, "penalty_damping must be finite and >= 0");
-    REQUIRE(isfinite(d->sleep_time) && d->sleep_time >= 0, "sleep_time must be finite and >= 0");
-    REQUIRE(isfinite(d->sleep_linear_velocity) && d->sleep_linear_velocity >= 0,
-            "sleep_linear_velocity must be finite and >= 0");
-    REQUIRE(isfinite(d->sleep_angular_velocity) && d->sleep_angular_velocity >= 0,
-            "sleep_angular_velocity must be finite and >= 0");
+    REQUIRE(d->penalty_stiffness >= 0 && d->penalty_stiffness <= RANGE_PENALTY_MAX,
+            "penalty_stiffness must be in [0, 1e20] N/m (got %g)", d->penalty_stiffness);
+    REQUIRE(d->penalty_damping >= 0 && d->penalty_damping <= RANGE_PENALTY_MAX,
+            "penalty_damping must be in [0, 1e20] N s/m (got %g)", d->penalty_damping);
+    REQUIRE(d->sleep_time >= 0 && d->sleep_time <= 1e9, "sleep_time must be in [0, 1e9] s (got %g)", d->sleep_time);
+    REQUIRE(d->sleep_linear_velocity >= 0 && d->sleep_linear_velocity <= RANGE_SPEED_MAX,
+            "sleep_linear_velocity must be in [0, 1e9] m/s (got %g)", d->sleep_linear_velocity);
+    REQUIRE(d->sleep_angular_velocity >= 0 && d->sleep_angular_velocity <= RANGE_SPEED_MAX,
+            "sleep_angular_velocity must be in [0, 1e9] rad/s (got %g)", d->sleep_angular_velocity);
     REQUIRE(d->max_linear_speed > 0 && d->max_linear_speed <= 1e9, "max_linear_speed must be in (0, 1e9]");
     REQUIRE(d->max_angular_speed > 0 && d->max_angular_speed <= 1e9, "max_angular_speed must be in (0, 1e9]");
     REQUIRE(isfinite(d->contact_reuse_distance) && d->contact_reuse_distance >= 0 && d->contact_reuse_distance <= 0.01,
@@ -263,8 +269,10 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
 {
     if (!w) return CAROM_ERROR_INVALID_ARGUMENT;
     if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "step: world is locked (called from a callback?)");
-    if (!isfinite(dt) || dt <= 0 || dt > 1.0)
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "step: dt must be in (0, 1] seconds (got %g)", dt);
+    /* below 1e-6 s a hit's average force J / dt and the soft contact's 1 / h
+     * leave the ranges' arithmetic (the smallest double passed as dt made it inf) */
+    if (!(dt >= RANGE_DT_MIN && dt <= RANGE_DT_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "step: dt must be in [1e-6, 1] seconds (got %g)", dt);
     double t0 = now_ms();
     w->locked = 1;
     w->last_dt = dt;

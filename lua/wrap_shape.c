@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "carom_lua.h"
+#include "ranges.h"
 
 const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", NULL};
 
@@ -62,6 +63,8 @@ static double positive_field(lua_State *L, const char *fname, const char *key)
     double v = 0;
     if (!clua_field_number(L, 1, fname, key, &v)) clua_arg_error(L, 1, fname, "%s is required", key);
     if (!(v > 0)) clua_arg_error(L, 1, fname, "%s must be positive", key);
+    if (!(v >= RANGE_LENGTH_MIN && v <= RANGE_LENGTH_MAX))
+        clua_arg_error(L, 1, fname, "%s %g is outside the length range [1e-6, 1e6] m", key, v);
     return v;
 }
 
@@ -83,6 +86,9 @@ static int l_box(lua_State *L)
     carom_vec3 h;
     if (!clua_field_vec3(L, 1, "box", "half_extents", &h)) clua_arg_error(L, 1, "box", "half_extents is required");
     if (!(h.x > 0 && h.y > 0 && h.z > 0)) clua_arg_error(L, 1, "box", "half_extents must be positive");
+    if (!(h.x >= RANGE_LENGTH_MIN && h.x <= RANGE_LENGTH_MAX && h.y >= RANGE_LENGTH_MIN && h.y <= RANGE_LENGTH_MAX &&
+          h.z >= RANGE_LENGTH_MIN && h.z <= RANGE_LENGTH_MAX))
+        clua_arg_error(L, 1, "box", "half_extents {%g, %g, %g} must each be in the length range [1e-6, 1e6] m", h.x, h.y, h.z);
     new_shape(L)->def = carom_shape_box(h.x, h.y, h.z);
     return 1;
 }
@@ -136,6 +142,8 @@ static int l_hull(lua_State *L)
             if (lua_rawgeti(L, -1, c + 1) != LUA_TNUMBER) clua_arg_error(L, 1, "hull", "point %d is not a vector of 3 numbers", (int)i + 1);
             double v = lua_tonumber(L, -1);
             if (!isfinite(v)) clua_arg_error(L, 1, "hull", "point %d is not finite", (int)i + 1);
+            if (!(fabs(v) <= RANGE_LENGTH_MAX))
+                clua_arg_error(L, 1, "hull", "point %d has coordinate %g; each must be within 1e6 m of the body origin", (int)i + 1, v);
             s->points[3 * i + c] = v;
             lua_pop(L, 1);
         }
@@ -161,6 +169,9 @@ static int l_plane(lua_State *L)
     if (n.x == 0 && n.y == 0 && n.z == 0) clua_arg_error(L, 1, "plane", "normal must not be zero");
     double len = sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
     if (!isfinite(len)) clua_arg_error(L, 1, "plane", "normal is too long");
+    if (!(len >= RANGE_NORMAL_MIN)) clua_arg_error(L, 1, "plane", "normal is shorter than 1e-12");
+    if (!(fabs(offset / len) <= RANGE_COORDINATE_MAX))
+        clua_arg_error(L, 1, "plane", "offset %g is outside [-1e12, 1e12] m", offset / len);
     new_shape(L)->def = carom_shape_plane(n.x, n.y, n.z, offset);
     return 1;
 }

@@ -1,0 +1,39 @@
+/* ranges.h - the ranges a world supports (docs/ranges.md has the table and
+ * the derivation). Every public entry refuses a value outside them at the
+ * call that introduces it, naming the value and the limit.
+ *
+ * Why these numbers: inside them every product the step forms stays below
+ * about 1e100 and every divisor above 1e-100, far inside double precision
+ * (1.8e308 .. 2.2e-308), with room for sums over millions of bodies:
+ *   kinetic energy m v^2 <= 1e15 (1e9)^2 = 1e33; I w^2 <= 1e30 (1e9)^2 = 1e48;
+ *   the inertia's determinant (m3_inverse) I^3 in [1e-72, 1e90], and of its
+ *   inverse likewise; a contact's r^2 / I <= (2e6)^2 / 1e-24 = 4e36;
+ *   a hit's J / dt <= (1e15 * 2e9) / 1e-6 = 2e30; mu N <= 1e3 * 2e24;
+ *   the soft contact's h omega in [1.6e-8 * 2 pi 1e-3, 1 * 2 pi 1e6]. */
+#ifndef CAROM_RANGES_H
+#define CAROM_RANGES_H
+
+#define RANGE_COORDINATE_MAX 1e12   /* m: |position component|, |plane offset| */
+#define RANGE_LENGTH_MIN 1e-6       /* m: radius, half extent, half height */
+#define RANGE_LENGTH_MAX 1e6        /* m: the same, and |hull point component| */
+#define RANGE_MASS_MIN 1e-9         /* kg: a dynamic body's mass, given or from density */
+#define RANGE_MASS_MAX 1e15         /* kg */
+#define RANGE_DENSITY_MIN 1e-6      /* kg/m^3 (0 = not used) */
+#define RANGE_DENSITY_MAX 1e9       /* kg/m^3 */
+#define RANGE_INERTIA_MIN 1e-24     /* kg m^2: smallest principal moment (a lower bound of it) */
+#define RANGE_INERTIA_MAX 1e30      /* kg m^2: largest principal moment (an upper bound of it) */
+#define RANGE_SPEED_MAX 1e9         /* m/s and rad/s: ceiling of max_linear/angular_speed */
+#define RANGE_ACCELERATION_MAX 1e9  /* m/s^2: |gravity| x |gravity_scale|, |force| / mass */
+#define RANGE_GRAVITY_MAX 1e4       /* m/s^2: |world gravity| */
+#define RANGE_GRAVITY_SCALE_MAX 1e4 /* |gravity_scale| */
+#define RANGE_FRICTION_MAX 1e3      /* Coulomb mu */
+#define RANGE_DAMPING_MAX 1e6       /* 1/s */
+#define RANGE_DT_MIN 1e-6           /* s: carom_world_step */
+#define RANGE_DT_MAX 1.0            /* s */
+#define RANGE_HERTZ_MIN 1e-3        /* contact_hertz */
+#define RANGE_HERTZ_MAX 1e6
+#define RANGE_RATIO_MAX 1e6         /* contact_damping_ratio */
+#define RANGE_PENALTY_MAX 1e20      /* penalty_stiffness (N/m), penalty_damping (N s/m) */
+#define RANGE_NORMAL_MIN 1e-12      /* length of a plane normal or a lock_to_plane normal */
+
+#endif
