@@ -7,6 +7,7 @@
 #include "world.h"
 #include "narrowphase.h"
 #include "ranges.h"
+#include "mesh.h"
 
 #define MAX_COORDINATE RANGE_COORDINATE_MAX
 
@@ -120,6 +121,14 @@ static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_typ
                 FAIL("body_create: hull point %d has coordinate %g; each must be finite with |c| <= 1e6 m", i / 3,
                      sd->points[i]);
         break;
+    case CAROM_SHAPE_MESH:
+    case CAROM_SHAPE_HEIGHTFIELD: {
+        const char *what = sd->type == CAROM_SHAPE_MESH ? "mesh" : "heightfield";
+        if (type == CAROM_BODY_DYNAMIC)
+            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a %s can only be a static or kinematic body "
+                              "(use a hull or a compound of convex pieces for a dynamic one)", what), 0;
+        break;
+    }
     case CAROM_SHAPE_PLANE:
         if (type != CAROM_BODY_STATIC) FAIL("body_create: a plane can only be a static body");
         if (!normal_ok(sd->normal)) FAIL("body_create: plane normal must be finite with length >= 1e-12");
@@ -227,6 +236,36 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
 
     shape sh;
     build_shape(&d.shape, &sh);
+    if (d.shape.type == CAROM_SHAPE_MESH) {
+        char err[160];
+        if (!d.mesh || d.mesh->size < offsetof(carom_mesh_def, two_sided) + sizeof(int)) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: mesh: def.mesh is %s",
+                       d.mesh ? "too small (use carom_mesh_def_default())" : "NULL");
+            return null_id;
+        }
+        const carom_mesh_def *md = d.mesh;
+        sh.mesh = mesh_build(md->vertices, md->vertex_count, md->triangles, md->triangle_count, md->two_sided, err,
+                             (int)sizeof err);
+        if (!sh.mesh) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s", err);
+            return null_id;
+        }
+    }
+    if (d.shape.type == CAROM_SHAPE_HEIGHTFIELD) {
+        char err[160];
+        if (!d.heightfield || d.heightfield->size < offsetof(carom_heightfield_def, hole_count) + sizeof(int)) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: heightfield: def.heightfield is %s",
+                       d.heightfield ? "too small (use carom_heightfield_def_default())" : "NULL");
+            return null_id;
+        }
+        const carom_heightfield_def *hd = d.heightfield;
+        sh.field = heightfield_build(hd->heights, hd->rows, hd->columns, hd->cell_x, hd->cell_y, hd->holes,
+                                     hd->hole_count, err, (int)sizeof err);
+        if (!sh.field) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s", err);
+            return null_id;
+        }
+    }
     if (d.shape.type == CAROM_SHAPE_HULL) {
         char err[160];
         sh.hull = hull_build(d.shape.points, d.shape.point_count, err, (int)sizeof err);
@@ -249,11 +288,11 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     if (sh.type != SHAPE_PLANE)
         mp = d.mass > 0 ? shape_mass_from_mass(&sh, d.mass) : shape_mass_from_density(&sh, d.density);
     if (d.type == CAROM_BODY_DYNAMIC && !check_mass_props(w, &mp, "body_create")) {
-        hull_free(sh.hull);
+        shape_free_data(&sh);
         return null_id;
     }
     if (!body_store_reserve(&w->bodies)) {
-        hull_free(sh.hull);
+        shape_free_data(&sh);
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
         return null_id;
     }
@@ -300,7 +339,7 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->proxy[slot] = bp_create_proxy(w->bp, fat, d.type == CAROM_BODY_STATIC, id_index);
     if (s->proxy[slot] < 0) {
         body_store_remove(s, slot);
-        hull_free(sh.hull);
+        shape_free_data(&sh);
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory (broadphase)");
         return null_id;
     }
@@ -323,7 +362,7 @@ CAROM_API carom_status carom_body_destroy(carom_world *w, carom_body_id id)
     REQUIRE_UNLOCKED(w, "body_destroy");
     world_remove_body_contacts(w, (int)id.index1 - 1);
     bp_destroy_proxy(w->bp, w->bodies.proxy[slot]);
-    hull_free(w->bodies.shapes[slot].hull);
+    shape_free_data(&w->bodies.shapes[slot]);
     body_store_remove(&w->bodies, slot);
     return CAROM_OK;
 }
@@ -561,6 +600,8 @@ CAROM_API carom_status carom_body_set_type(carom_world *w, carom_body_id id, car
     if (s->type[slot] == (int)type) return CAROM_OK;
     if (s->shapes[slot].type == SHAPE_PLANE)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a plane must stay static");
+    if (type == CAROM_BODY_DYNAMIC && shape_is_composite(&s->shapes[slot]))
+        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a mesh or heightfield cannot be dynamic");
     if (type == CAROM_BODY_DYNAMIC) {
         mass_props mp = {s->mass[slot], s->local_center[slot], s->inertia_local[slot]};
         if (!(s->mass[slot] > 0)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: body has no mass");

@@ -151,6 +151,68 @@ static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa
     c->flags |= CONTACT_REUSABLE;
 }
 
+/* A pair with a mesh or height field: its manifolds (one per normal) go to
+ * the pair's contact (sub 0) and its extra contacts (sub 1..), each manifold
+ * to the contact whose last normal is nearest, so warm starting follows it.
+ * near: the bounds are within the look-ahead (else every manifold empties).
+ * Returns 1 when any manifold has points; 0 on out of memory too (the pair
+ * then keeps only what fits). */
+static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, double spec, int near)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    int id_a = cs->items[ci].id_a, id_b = cs->items[ci].id_b;
+    int a = s->ids[id_a].slot, b = s->ids[id_b].slot;
+    manifold found[COMPOSITE_MAX_MANIFOLDS];
+    int n = near ? collide_composite(&s->shapes[a], xa, &s->shapes[b], xb, spec, found, COMPOSITE_MAX_MANIFOLDS) : 0;
+    int slot_of[COMPOSITE_MAX_MANIFOLDS], taken[COMPOSITE_MAX_MANIFOLDS] = {0, 0, 0, 0};
+    int index[COMPOSITE_MAX_MANIFOLDS];
+    for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) index[k] = k == 0 ? ci : contact_find_sub(cs, id_a, id_b, (uint32_t)k);
+    for (int j = 0; j < n; j++) {
+        /* the contact that last had the nearest normal, else the first free one */
+        int best = -1;
+        double best_dot = 0.9;
+        for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
+            if (taken[k] || index[k] < 0 || cs->data[index[k]].m.count == 0) continue;
+            double d = v3_dot(cs->data[index[k]].m.normal, found[j].normal);
+            if (d > best_dot) { best_dot = d; best = k; }
+        }
+        for (int k = 0; best < 0 && k < COMPOSITE_MAX_MANIFOLDS; k++)
+            if (!taken[k] && (index[k] < 0 || cs->data[index[k]].m.count == 0)) best = k;
+        taken[best] = 1;
+        slot_of[j] = best;
+    }
+    int any = 0;
+    for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
+        int j = -1;
+        for (int q = 0; q < n; q++) if (slot_of[q] == k) j = q;
+        if (index[k] < 0) {
+            if (j < 0) continue;
+            index[k] = contact_add_sub(cs, id_a, id_b, (uint32_t)k);
+            if (index[k] < 0) continue; /* out of memory: this manifold is dropped this step */
+            cs->data[index[k]].friction = cs->data[ci].friction;
+            cs->data[index[k]].restitution = cs->data[ci].restitution;
+        }
+        contact *c = &cs->items[index[k]];
+        contact_data *d = &cs->data[index[k]];
+        c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
+        if (j < 0) {
+            d->m.count = 0;
+        } else {
+            manifold old_m = d->m;
+            contact_point_state old_state[MANIFOLD_MAX_POINTS];
+            memcpy(old_state, d->state, sizeof old_state);
+            d->m = found[j];
+            contact_match_points(d, &old_m, old_state, xa);
+            any = 1;
+        }
+        int was = (c->flags & CONTACT_TOUCHING) != 0;
+        c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
+                   (d->m.count > 0 ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
+    }
+    return any;
+}
+
 /* Wakes a sleeping body during the collision stage; its later pairs read
  * this step's frame and bounds like every awake body's. */
 static void wake_for_step(carom_world *w, int slot)
@@ -181,12 +243,20 @@ int world_collide(carom_world *w)
         contact *c = &cs->items[i];
         contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        if (c->sub) {
+            /* an extra manifold of a mesh pair: the pair's own contact (sub 0)
+             * computes it; it goes when the pair does */
+            if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) contact_remove(cs, i);
+            else i++;
+            continue;
+        }
         int awake_a = s->type[a] != CAROM_BODY_STATIC && (s->flags[a] & BODY_AWAKE);
         int awake_b = s->type[b] != CAROM_BODY_STATIC && (s->flags[b] & BODY_AWAKE);
+        int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
-            if (c->flags & CONTACT_TOUCHING) push_touch_event(w, c, d, CAROM_EVENT_END);
+            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, c, d, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
@@ -198,6 +268,31 @@ int world_collide(carom_world *w)
          * (the gap between boxes bounds the distance), so skip the narrowphase */
         aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
         int touching = 0; /* known without reading the manifold where possible */
+        if (composite) {
+            xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
+            int near = aabb_overlap(aabb_fatten(ba, spec), bb);
+            touching = collide_composite_pair(w, i, xa, xb, spec, near);
+            c = &cs->items[i]; /* extra contacts may have moved the arrays */
+            d = &cs->data[i];
+            int was = (c->flags & CONTACT_ANY_TOUCHING) != 0;
+            c->flags = (c->flags & ~(uint32_t)CONTACT_ANY_TOUCHING) | (touching ? CONTACT_ANY_TOUCHING : 0);
+            if (touching && (!awake_a || !awake_b)) {
+                if (!awake_a) wake_for_step(w, a);
+                if (!awake_b) wake_for_step(w, b);
+            }
+            if (touching != was) {
+                /* the event speaks of the pair: any manifold with points */
+                const contact_data *ed = d;
+                for (uint32_t k = 1; ed->m.count == 0 && k < COMPOSITE_MAX_MANIFOLDS; k++) {
+                    int e = contact_find_sub(cs, c->id_a, c->id_b, k);
+                    if (e >= 0 && cs->data[e].m.count > 0) ed = &cs->data[e];
+                }
+                push_touch_event(w, c, ed, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
+            }
+            if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
+            i++;
+            continue;
+        }
         if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
             xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
             if (reuse_manifold(c, d, xa, xb, reuse)) {
@@ -236,6 +331,14 @@ int world_collide(carom_world *w)
         else if (!touching && was) push_touch_event(w, c, d, CAROM_EVENT_END);
         if (touching) sc->touching[sc->touching_count++] = i;
         i++;
+    }
+    /* the extra manifolds of the mesh pairs computed above */
+    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
+    for (int i = 0; i < cs->count; i++) {
+        const contact *c = &cs->items[i];
+        if (!c->sub || !(c->flags & CONTACT_TOUCHING)) continue;
+        int primary = contact_find(cs, c->id_a, c->id_b);
+        if (primary >= 0 && (cs->items[primary].flags & CONTACT_SIM)) sc->touching[sc->touching_count++] = i;
     }
     return 1;
 }

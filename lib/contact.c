@@ -10,8 +10,9 @@ static uint64_t pair_key(int a, int b)
     return ((uint64_t)(uint32_t)(a + 1) << 32) | (uint64_t)(uint32_t)(b + 1);
 }
 
-static uint32_t hash_key(uint64_t k)
+static uint32_t hash_key(uint64_t k, uint32_t sub)
 {
+    k ^= (uint64_t)sub * 0x9E3779B97F4A7C15ULL;
     k ^= k >> 33;
     k *= 0xff51afd7ed558ccdULL;
     k ^= k >> 33;
@@ -23,25 +24,27 @@ static uint32_t hash_key(uint64_t k)
 static int map_init(pair_map *m, int capacity)
 {
     m->keys = calloc((size_t)capacity, sizeof *m->keys);
+    m->subs = calloc((size_t)capacity, sizeof *m->subs);
     m->values = malloc((size_t)capacity * sizeof *m->values);
     m->capacity = capacity;
     m->count = 0;
-    return m->keys && m->values;
+    return m->keys && m->subs && m->values;
 }
 
-static int map_slot(const pair_map *m, uint64_t key)
+static int map_slot(const pair_map *m, uint64_t key, uint32_t sub)
 {
     uint32_t mask = (uint32_t)m->capacity - 1;
-    uint32_t i = hash_key(key) & mask;
-    while (m->keys[i] != 0 && m->keys[i] != key) i = (i + 1) & mask;
+    uint32_t i = hash_key(key, sub) & mask;
+    while (m->keys[i] != 0 && (m->keys[i] != key || m->subs[i] != sub)) i = (i + 1) & mask;
     return (int)i;
 }
 
-static void map_put(pair_map *m, uint64_t key, int value)
+static void map_put(pair_map *m, uint64_t key, uint32_t sub, int value)
 {
-    int i = map_slot(m, key);
+    int i = map_slot(m, key, sub);
     if (m->keys[i] == 0) m->count++;
     m->keys[i] = key;
+    m->subs[i] = sub;
     m->values[i] = value;
 }
 
@@ -50,22 +53,24 @@ static int map_grow(pair_map *m)
     pair_map n;
     if (!map_init(&n, m->capacity * 2)) {
         free(n.keys);
+        free(n.subs);
         free(n.values);
         return 0;
     }
     for (int i = 0; i < m->capacity; i++)
-        if (m->keys[i]) map_put(&n, m->keys[i], m->values[i]);
+        if (m->keys[i]) map_put(&n, m->keys[i], m->subs[i], m->values[i]);
     free(m->keys);
+    free(m->subs);
     free(m->values);
     *m = n;
     return 1;
 }
 
 /* Backward-shift deletion keeps probe chains intact without tombstones. */
-static void map_remove(pair_map *m, uint64_t key)
+static void map_remove(pair_map *m, uint64_t key, uint32_t sub)
 {
     uint32_t mask = (uint32_t)m->capacity - 1;
-    uint32_t i = (uint32_t)map_slot(m, key);
+    uint32_t i = (uint32_t)map_slot(m, key, sub);
     if (m->keys[i] == 0) return;
     m->keys[i] = 0;
     m->count--;
@@ -73,11 +78,12 @@ static void map_remove(pair_map *m, uint64_t key)
     for (;;) {
         j = (j + 1) & mask;
         if (m->keys[j] == 0) return;
-        uint32_t home = hash_key(m->keys[j]) & mask;
+        uint32_t home = hash_key(m->keys[j], m->subs[j]) & mask;
         /* move j back to i unless its home lies cyclically in (i, j] */
         int keep = (i <= j) ? (i < home && home <= j) : (i < home || home <= j);
         if (!keep) {
             m->keys[i] = m->keys[j];
+            m->subs[i] = m->subs[j];
             m->values[i] = m->values[j];
             m->keys[j] = 0;
             i = j;
@@ -96,18 +102,23 @@ void contact_set_free(contact_set *cs)
     free(cs->items);
     free(cs->data);
     free(cs->map.keys);
+    free(cs->map.subs);
     free(cs->map.values);
     memset(cs, 0, sizeof *cs);
 }
 
-int contact_find(const contact_set *cs, int a, int b)
+int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub)
 {
     uint64_t key = pair_key(a, b);
-    int i = map_slot(&cs->map, key);
+    int i = map_slot(&cs->map, key, sub);
     return cs->map.keys[i] == key ? cs->map.values[i] : -1;
 }
 
-int contact_add(contact_set *cs, int a, int b)
+int contact_find(const contact_set *cs, int a, int b) { return contact_find_sub(cs, a, b, 0); }
+
+int contact_add(contact_set *cs, int a, int b) { return contact_add_sub(cs, a, b, 0); }
+
+int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
@@ -119,19 +130,20 @@ int contact_add(contact_set *cs, int a, int b)
     c->id_a = a < b ? a : b;
     c->id_b = a < b ? b : a;
     c->cache.feature = -1;
-    map_put(&cs->map, pair_key(a, b), i);
+    c->sub = sub;
+    map_put(&cs->map, pair_key(a, b), sub, i);
     return i;
 }
 
 void contact_remove(contact_set *cs, int i)
 {
     contact *c = &cs->items[i];
-    map_remove(&cs->map, pair_key(c->id_a, c->id_b));
+    map_remove(&cs->map, pair_key(c->id_a, c->id_b), c->sub);
     int last = cs->count - 1;
     if (i != last) {
         cs->items[i] = cs->items[last];
         cs->data[i] = cs->data[last];
-        map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), i);
+        map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), cs->items[i].sub, i);
     }
     cs->count--;
 }

@@ -12,7 +12,8 @@ enum {
     CONTACT_WAS_TOUCHING = 1u << 1,
     CONTACT_SIM          = 1u << 2,   /* solved this step (both bodies not asleep) */
     CONTACT_REUSABLE     = 1u << 3,   /* rel_pose and the points' local_a/separation are valid */
-    CONTACT_APART        = 1u << 4    /* no manifold: rel_pose, gap and reach_b are valid */
+    CONTACT_APART        = 1u << 4,   /* no manifold: rel_pose, gap and reach_b are valid */
+    CONTACT_ANY_TOUCHING = 1u << 5    /* sub 0 of a mesh pair: some manifold of the pair has points */
 };
 
 typedef struct contact_point_state {
@@ -28,6 +29,8 @@ typedef struct contact_point_state {
 typedef struct contact {
     int id_a, id_b;             /* body id-table indices, id_a < id_b */
     uint32_t flags;
+    uint32_t sub;               /* 0: the broadphase pair's contact; k > 0: its k-th extra
+                                   manifold (a mesh or height field gives one per normal) */
     collide_cache cache;
     xform rel_pose;             /* B's frame in A's when the manifold was computed */
     double gap, reach_b;        /* apart: a lower bound on the distance then, and B's
@@ -46,6 +49,7 @@ typedef struct contact_data {
 /* Open-addressing map from an ordered pair of id indices to a contact index. */
 typedef struct pair_map {
     uint64_t *keys;             /* 0 = empty; key = ((a+1) << 32) | (b+1) */
+    uint32_t *subs;             /* with the key: the contact's sub */
     int *values;
     int capacity;               /* power of two */
     int count;
@@ -64,6 +68,9 @@ void contact_set_free(contact_set *cs);
 int contact_find(const contact_set *cs, int a, int b);
 /* Adds a contact for a new pair; returns its index or -1 on out of memory. */
 int contact_add(contact_set *cs, int a, int b);
+/* The same for a pair's extra manifold number sub (> 0). */
+int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub);
+int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub);
 /* Swap-removes contact i. */
 void contact_remove(contact_set *cs, int i);
 /* Carries warm-start impulses from the old manifold to the new one. */

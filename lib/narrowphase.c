@@ -7,32 +7,15 @@
 #include <ccd/ccd.h>
 #include "manifold.h"
 
-#define POLY_MAX_V HULL_MAX_VERTICES
-#define POLY_MAX_F HULL_MAX_FACES
-#define POLY_MAX_FV HULL_MAX_FACE_VERTICES
-#define CYL_SIDES 16
 #define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
 #define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */
 #define CLIP_TOLERANCE 5e-4   /* incident vertices this close outside a side plane are kept, so
                                  aligned stacks keep the same feature ids under tiny jitter */
 
-/* A convex polytope in world space. */
-typedef struct poly {
-    int nv, nf, ne;
-    vec3 v[POLY_MAX_V];
-    vec3 fn[POLY_MAX_F];
-    double fd[POLY_MAX_F];
-    int ffirst[POLY_MAX_F], fcount[POLY_MAX_F];
-    int fv[POLY_MAX_FV];
-    int e[POLY_MAX_FV / 2][2];
-    int ef[POLY_MAX_FV / 2][2];      /* the two faces beside each edge (Gauss-map arcs) */
-    vec3 center;
-} poly;
-
 /* ---- building polytopes ------------------------------------------------------- */
 
 /* Faces beside each edge, by matching face boundary segments to edges. */
-static void poly_edge_faces(poly *p)
+void poly_edge_faces(poly *p)
 {
     for (int i = 0; i < p->ne; i++) p->ef[i][0] = p->ef[i][1] = -1;
     for (int f = 0; f < p->nf; f++) {
@@ -48,7 +31,7 @@ static void poly_edge_faces(poly *p)
     }
 }
 
-static void poly_finish(poly *p)
+void poly_finish(poly *p)
 {
     p->center = v3_zero();
     for (int i = 0; i < p->nv; i++) p->center = v3_add(p->center, p->v[i]);
@@ -129,7 +112,7 @@ static void poly_from_cylinder(poly *p, double r, double hh, xform x)
     poly_finish(p);
 }
 
-static int poly_from_shape(poly *p, const shape *s, xform x)
+int poly_from_shape(poly *p, const shape *s, xform x)
 {
     switch (s->type) {
     case SHAPE_BOX: poly_from_box(p, s->half_extents, x); return 1;
@@ -154,7 +137,7 @@ static double poly_min_along(const poly *p, vec3 n)
 }
 
 /* Closest points of segments p1q1 and p2q2 (Ericson, Real-Time Collision Detection 5.1.9). */
-static void closest_segments(vec3 p1, vec3 q1, vec3 p2, vec3 q2, vec3 *c1, vec3 *c2)
+void closest_segments(vec3 p1, vec3 q1, vec3 p2, vec3 q2, vec3 *c1, vec3 *c2)
 {
     vec3 d1 = v3_sub(q1, p1), d2 = v3_sub(q2, p2), r = v3_sub(p1, p2);
     double a = v3_dot(d1, d1), e = v3_dot(d2, d2), f = v3_dot(d2, r), s, t;
@@ -326,7 +309,7 @@ static void sphere_box(const shape *a, xform xa, const shape *b, xform xb, doubl
     add_point(m, v3_madd(pb, 0.5 * sep, n), sep, 0);
 }
 
-static void capsule_segment(const shape *s, xform x, vec3 *p0, vec3 *p1)
+void capsule_segment(const shape *s, xform x, vec3 *p0, vec3 *p1)
 {
     vec3 axis = q_rotate(x.q, v3(0, 0, s->half_height));
     *p0 = v3_sub(x.p, axis);
@@ -394,7 +377,7 @@ static int cylinder_support_line(const shape *cyl, xform x, vec3 n, clip_vertex 
  * shape when it is a cylinder (its round side then touches along the true
  * line of support, not along a prism facet, which would let it settle onto
  * the facet: roll up to 11 degrees and away), else NULL. */
-static void poly_face_contact(const poly *ref, int rf, const poly *inc, const shape *inc_cyl, xform inc_x, int flip,
+void poly_face_contact(const poly *ref, int rf, const poly *inc, const shape *inc_cyl, xform inc_x, int flip,
                               double spec, uint32_t tag, manifold *m)
 {
     vec3 n = ref->fn[rf];
@@ -829,6 +812,16 @@ int collide(const shape *a, xform xa, const shape *b, xform xb, double speculati
     /* a pose that overflowed has no contacts (the feature searches below would
      * find no best face and index with -1) */
     if (!xform_is_finite(xa) || !xform_is_finite(xb)) return 0;
+    if (shape_is_composite(a) || shape_is_composite(b)) {
+        manifold all[COMPOSITE_MAX_MANIFOLDS];
+        int n = collide_composite(a, xa, b, xb, speculative, all, COMPOSITE_MAX_MANIFOLDS);
+        double deepest = 1e300;
+        for (int k = 0; k < n; k++)
+            for (int i = 0; i < all[k].count; i++)
+                if (all[k].points[i].separation < deepest) { deepest = all[k].points[i].separation; *m = all[k]; }
+        (void)cache;
+        return m->count;
+    }
     int swap = a->type > b->type;
     /* capsule (2) against box (1) is handled box-first; everything else by type order */
     if (swap) {

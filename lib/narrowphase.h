@@ -36,9 +36,23 @@ typedef struct collide_cache {
 /* Contacts between shape a at xa and shape b at xb, including speculative
  * points whose separation is below `speculative` (>= 0). Any order of types
  * works (the normal always points from a to b). Returns m->count. Results are
- * always finite. */
+ * always finite. A mesh or height field gives its deepest manifold only (the
+ * contact stage asks collide_composite for all of them). */
 int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative,
             collide_cache *cache, manifold *m);
+
+/* Most manifolds a convex shape gets against one mesh or height field. */
+#define COMPOSITE_MAX_MANIFOLDS 4
+
+/* A mesh or height field (either of a, b) against a convex shape: the
+ * triangles' contacts grouped by normal into up to `max` manifolds (normal
+ * from a to b), written to out; returns how many. triangle_contact.c. */
+int collide_composite(const shape *a, xform xa, const shape *b, xform xb, double speculative, manifold *out, int max);
+/* One triangle (world vertices, counter-clockwise seen from the front) against
+ * a convex shape; active: bit k set when edge v[k] -> v[k+1] is active (see
+ * mesh.h). The normal points from the triangle to the shape. */
+int collide_triangle(const vec3 v[3], unsigned active, int two_sided, const shape *s, xform xs, double speculative,
+                     manifold *m);
 
 /* Reduces up to n candidate points to at most 4 (deepest first, then the
  * largest area), in place; returns the new count. */

@@ -7,6 +7,7 @@
 #include <string.h>
 #include "array.h"
 #include "shape.h"
+#include "mesh.h"
 
 #define PI 3.14159265358979323846
 #define PLANE_EXTENT 1e18
@@ -145,10 +146,31 @@ aabb shape_aabb(const shape *s, xform t)
         }
         return b;
     }
+    case SHAPE_MESH: case SHAPE_HEIGHTFIELD: {
+        /* the local bounds' corners, rotated */
+        aabb lb = s->type == SHAPE_MESH ? mesh_bounds(s->mesh) : heightfield_bounds(s->field);
+        vec3 c = v3_scale(v3_add(lb.lo, lb.hi), 0.5), h = v3_scale(v3_sub(lb.hi, lb.lo), 0.5);
+        mat3 m = m3_from_quat(t.q);
+        vec3 e = v3_add(v3_add(v3_scale(v3_abs(m.c0), h.x), v3_scale(v3_abs(m.c1), h.y)), v3_scale(v3_abs(m.c2), h.z));
+        vec3 wc = xf_point(t, c);
+        b.lo = v3_sub(wc, e);
+        b.hi = v3_add(wc, e);
+        return b;
+    }
     default:
         b.lo = b.hi = t.p;
         return b;
     }
+}
+
+void shape_free_data(shape *s)
+{
+    hull_free(s->hull);
+    mesh_free(s->mesh);
+    heightfield_free(s->field);
+    s->hull = NULL;
+    s->mesh = NULL;
+    s->field = NULL;
 }
 
 vec3 shape_support_local(const shape *s, vec3 d)
@@ -200,6 +222,10 @@ double shape_bounding_radius(const shape *s)
         double m = 0;
         for (int i = 0; i < s->hull->vertex_count; i++) m = dmax(m, v3_len(s->hull->vertices[i]));
         return m;
+    }
+    case SHAPE_MESH: case SHAPE_HEIGHTFIELD: {
+        aabb lb = s->type == SHAPE_MESH ? mesh_bounds(s->mesh) : heightfield_bounds(s->field);
+        return v3_len(v3_max(v3_abs(lb.lo), v3_abs(lb.hi)));
     }
     default: return PLANE_EXTENT;
     }
@@ -1122,6 +1148,12 @@ int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t
         n = s->plane_normal;
         break;
     }
+    case SHAPE_MESH:
+        if (!mesh_ray_cast(s->mesh, o, d, max_t, &tt, &n, NULL)) return 0;
+        break;
+    case SHAPE_HEIGHTFIELD:
+        if (!heightfield_ray_cast(s->field, o, d, max_t, &tt, &n, NULL)) return 0;
+        break;
     default:
         return 0;
     }

@@ -12,6 +12,8 @@ enum {
     SHAPE_CYLINDER,     /* axis local z, from -half_height to +half_height, radius */
     SHAPE_HULL,         /* convex hull, vertices in the body frame */
     SHAPE_PLANE,        /* static only: points x with dot(normal, x) = offset (body frame); solid below */
+    SHAPE_MESH,         /* static or kinematic: triangles (mesh.h) */
+    SHAPE_HEIGHTFIELD,  /* static or kinematic: a grid of heights (mesh.h) */
     SHAPE_TYPE_COUNT
 };
 
@@ -44,7 +46,14 @@ typedef struct shape {
     hull *hull;            /* SHAPE_HULL: owned by the shape */
     vec3 plane_normal;     /* SHAPE_PLANE: unit */
     double plane_offset;
+    struct tri_mesh *mesh;        /* SHAPE_MESH: owned by the shape */
+    struct height_field *field;   /* SHAPE_HEIGHTFIELD: owned by the shape */
 } shape;
+
+/* Meshes and height fields: many triangles, contacts in several manifolds. */
+static inline int shape_is_composite(const shape *s) { return s->type == SHAPE_MESH || s->type == SHAPE_HEIGHTFIELD; }
+/* Frees what the shape owns (hull, mesh, height field). */
+void shape_free_data(shape *s);
 
 typedef struct mass_props {
     double mass;

@@ -178,7 +178,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
         world_fail(w, CAROM_ERROR_LOCKED, "world_destroy: the world is inside its step; destroy it afterwards");
         return;
     }
-    for (int i = 0; i < w->bodies.count; i++) hull_free(w->bodies.shapes[i].hull);
+    for (int i = 0; i < w->bodies.count; i++) shape_free_data(&w->bodies.shapes[i]);
     body_store_free(&w->bodies);
     if (w->bp) bp_destroy(w->bp);
     contact_set_free(&w->contacts);

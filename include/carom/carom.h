@@ -211,8 +211,57 @@ typedef enum carom_shape_type {
     CAROM_SHAPE_CAPSULE = 2,  /* radius, half_height: segment on the local z axis */
     CAROM_SHAPE_CYLINDER = 3, /* radius, half_height: axis local z */
     CAROM_SHAPE_HULL = 4,     /* points (x,y,z triples), point_count >= 4, not coplanar */
-    CAROM_SHAPE_PLANE = 5     /* static only: dot(normal, x) = offset; solid where < offset */
+    CAROM_SHAPE_PLANE = 5,    /* static only: dot(normal, x) = offset; solid where < offset */
+    CAROM_SHAPE_MESH = 6,     /* static or kinematic: triangles, from carom_body_def.mesh */
+    CAROM_SHAPE_HEIGHTFIELD = 7 /* static or kinematic: a grid of heights, from carom_body_def.heightfield */
 } carom_shape_type;
+
+/* A triangle mesh, copied at body creation (the body builds its own
+ * bounding-volume tree once). Zero-area triangles are dropped. Edges shared
+ * by two triangles at (nearly) the same slope, or folded concavely, do not
+ * catch what slides across them. */
+typedef struct carom_mesh_def {
+    uint32_t size;            /* sizeof(carom_mesh_def), stamped by the default */
+    const double *vertices;   /* x, y, z triples in the body frame */
+    int vertex_count;
+    const int *triangles;     /* 0-based vertex index triples, counter-clockwise seen from the front */
+    int triangle_count;
+    int two_sided;            /* 0: triangles collide on their front side only */
+} carom_mesh_def;
+
+static inline carom_mesh_def carom_mesh_def_default(void)
+{
+    carom_mesh_def d;
+    d.size = (uint32_t)sizeof(carom_mesh_def);
+    d.vertices = 0; d.vertex_count = 0;
+    d.triangles = 0; d.triangle_count = 0;
+    d.two_sided = 0;
+    return d;
+}
+
+/* A height field, copied at body creation (no triangle list is kept). The
+ * grid is centred on the body origin in x and y, heights are along +z;
+ * heights[r * columns + c] is at x = (c - (columns - 1) / 2) cell_x,
+ * y = (r - (rows - 1) / 2) cell_y. Cell (c, r), index r * (columns - 1) + c,
+ * spans grid points c..c+1, r..r+1. */
+typedef struct carom_heightfield_def {
+    uint32_t size;            /* sizeof(carom_heightfield_def), stamped by the default */
+    const double *heights;    /* rows * columns, row 0 at the lowest y */
+    int rows, columns;        /* >= 2 each */
+    double cell_x, cell_y;    /* grid spacing (m), > 0 */
+    const int *holes;         /* NULL or hole_count cell indices without ground */
+    int hole_count;
+} carom_heightfield_def;
+
+static inline carom_heightfield_def carom_heightfield_def_default(void)
+{
+    carom_heightfield_def d;
+    d.size = (uint32_t)sizeof(carom_heightfield_def);
+    d.heights = 0; d.rows = 0; d.columns = 0;
+    d.cell_x = 1.0; d.cell_y = 1.0;
+    d.holes = 0; d.hole_count = 0;
+    return d;
+}
 
 typedef struct carom_shape_def {
     carom_shape_type type;
@@ -285,6 +334,8 @@ typedef struct carom_body_def {
     int enable_sleep;              /* 1 */
     int awake;                     /* 1 */
     void *user_data;               /* NULL */
+    const carom_mesh_def *mesh;    /* NULL: shape.type CAROM_SHAPE_MESH reads it */
+    const carom_heightfield_def *heightfield; /* NULL: shape.type CAROM_SHAPE_HEIGHTFIELD reads it */
 } carom_body_def;
 
 static inline carom_body_def carom_body_def_default(void)
@@ -311,6 +362,8 @@ static inline carom_body_def carom_body_def_default(void)
     d.enable_sleep = 1;
     d.awake = 1;
     d.user_data = 0;
+    d.mesh = 0;
+    d.heightfield = 0;
     return d;
 }
 

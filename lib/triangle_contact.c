@@ -1,0 +1,402 @@
+/* triangle_contact.c - convex shapes against the triangles of meshes and
+ * height fields.
+ *
+ * One triangle: a one-sided triangle is treated as the half-infinite prism
+ * below it (its face, and side walls at its edges), so the separating-axis
+ * test only ever finds normals on the front side. Spheres and capsules take
+ * the face when their core projects onto it, else the nearest edge or vertex.
+ *
+ * Internal edges: each triangle edge is flagged active when its neighbour is
+ * folded away from it (a convex crease of more than 5 degrees) or missing
+ * (mesh boundary, a hole). A contact whose normal comes from an inactive edge
+ * or from a vertex with only inactive edges is turned to the triangle's face
+ * normal: on a flat or concave join the neighbour's face holds the body, and
+ * the edge normal would only make it bump or snag (the approach of Jolt's
+ * active edges; Bullet's btAdjustInternalEdgeContacts corrects the normal
+ * after the fact with the same adjacency). Face contacts are left alone.
+ *
+ * Many triangles: the contacts of all triangles overlapping the convex shape
+ * are grouped by normal (within 2.5 degrees), each group reduced to four
+ * points; a flat floor of any number of triangles gives one manifold, a floor
+ * and a wall two. */
+#include <stdlib.h>
+#include <string.h>
+#include "manifold.h"
+#include "mesh.h"
+
+#define TRI_FACE_TOLERANCE 1e-3   /* prefer the triangle's face unless another axis separates more (m) */
+#define GROUP_COS 0.999           /* contacts within ~2.5 degrees of a group's normal join it */
+#define GROUP_CAPACITY 64
+
+/* ---- one triangle ------------------------------------------------------------- */
+
+static void triangle_poly(poly *p, const vec3 v[3], vec3 n)
+{
+    p->nv = 3; p->nf = 2; p->ne = 3;
+    for (int k = 0; k < 3; k++) {
+        p->v[k] = v[k];
+        p->e[k][0] = k;
+        p->e[k][1] = (k + 1) % 3;
+    }
+    p->fn[0] = n; p->ffirst[0] = 0; p->fcount[0] = 3;
+    p->fv[0] = 0; p->fv[1] = 1; p->fv[2] = 2;
+    p->fn[1] = v3_neg(n); p->ffirst[1] = 3; p->fcount[1] = 3;
+    p->fv[3] = 0; p->fv[4] = 2; p->fv[5] = 1;
+    poly_finish(p);
+}
+
+/* Outward side direction of edge k (in the triangle's plane). */
+static vec3 edge_side(const vec3 v[3], vec3 n, int k)
+{
+    return v3_normalize(v3_cross(v3_sub(v[(k + 1) % 3], v[k]), n));
+}
+
+static int vertex_active(unsigned active, int i) { return (active >> i & 1u) || (active >> ((i + 2) % 3) & 1u); }
+
+static void push_point(manifold *m, vec3 p, double sep, uint32_t id)
+{
+    if (m->count >= MANIFOLD_MAX_POINTS) return;
+    m->points[m->count].point = p;
+    m->points[m->count].separation = sep;
+    m->points[m->count].id = id;
+    m->count++;
+}
+
+/* A sphere or capsule (core c0..c1, radius r) against the triangle. */
+static void triangle_core(const vec3 v[3], vec3 n, unsigned active, vec3 c0, vec3 c1, double r, double spec, manifold *m)
+{
+    double d = v3_dot(n, v[0]);
+    m->normal = n;
+    if (v3_dot(n, c0) - d < 0 && v3_dot(n, c1) - d < 0) return; /* behind a one-sided face */
+    int seg = v3_len2(v3_sub(c1, c0)) > 0;
+    clip_vertex b1[4], b2[4];
+    b1[0].p = c0; b1[0].id = 0;
+    b1[1].p = c1; b1[1].id = 1;
+    clip_vertex *in = b1, *out = b2;
+    int nb = seg ? 2 : 1;
+    for (int k = 0; k < 3 && nb > 0; k++) {
+        vec3 side = edge_side(v, n, k);
+        double sd = v3_dot(side, v[k]);
+        if (nb == 2) {
+            nb = clip_polygon(in, 2, side, sd, (uint32_t)k, out);
+            if (nb > 2) nb = 2;
+        } else {
+            nb = v3_dot(side, in[0].p) <= sd ? 1 : 0;
+            out[0] = in[0];
+        }
+        clip_vertex *t = in; in = out; out = t;
+    }
+    if (nb > 0) { /* the core projects onto the face */
+        for (int i = 0; i < nb; i++) {
+            double sep = v3_dot(n, in[i].p) - d - r;
+            if (sep < spec) push_point(m, v3_madd(in[i].p, -(r + 0.5 * sep), n), sep, in[i].id & 0xffffu);
+        }
+        return;
+    }
+    /* nearest edge or vertex */
+    double best = 1e300, best_s = 0;
+    vec3 q = v[0], pc = c0;
+    int bk = 0;
+    for (int k = 0; k < 3; k++) {
+        vec3 a, b;
+        closest_segments(v[k], v[(k + 1) % 3], c0, c1, &a, &b);
+        double d2 = v3_len2(v3_sub(b, a));
+        if (d2 < best) {
+            vec3 e = v3_sub(v[(k + 1) % 3], v[k]);
+            best = d2; q = a; pc = b; bk = k;
+            best_s = v3_dot(v3_sub(a, v[k]), e) / v3_len2(e);
+        }
+    }
+    int feature_active = best_s <= 1e-9 ? vertex_active(active, bk)
+                       : best_s >= 1 - 1e-9 ? vertex_active(active, (bk + 1) % 3) : (int)(active >> bk & 1u);
+    double dist = sqrt(best);
+    vec3 nrm;
+    double sep;
+    if (!feature_active || dist < 1e-12) {
+        nrm = n; /* an internal edge: the neighbour's face continues this one */
+        sep = v3_dot(n, v3_sub(pc, q)) - r;
+    } else {
+        nrm = v3_scale(v3_sub(pc, q), 1.0 / dist);
+        sep = dist - r;
+        if (v3_dot(nrm, n) < 0) return; /* from below a one-sided face */
+    }
+    m->normal = nrm;
+    if (sep < spec) push_point(m, v3_madd(pc, -(r + 0.5 * sep), nrm), sep, 0x100u + (uint32_t)bk);
+}
+
+/* A polytope p (built from shape s at xs; edge faces filled) against the triangle. */
+static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const poly *p, const shape *s, xform xs,
+                              double spec, manifold *m)
+{
+    double d = v3_dot(n, v[0]);
+    m->normal = n;
+    if (v3_dot(n, p->center) - d < 0) return; /* behind a one-sided face */
+    double sep_t = 1e300;
+    for (int i = 0; i < p->nv; i++) sep_t = dmin(sep_t, v3_dot(n, p->v[i]));
+    sep_t -= d;
+    if (sep_t > spec) return;
+    /* the polytope's faces whose outward normal looks at the triangle's front */
+    double sep_f = -1e300;
+    int best_f = -1;
+    for (int f = 0; f < p->nf; f++) {
+        if (v3_dot(p->fn[f], n) > 1e-9) continue;
+        double sv = 1e300;
+        for (int k = 0; k < 3; k++) sv = dmin(sv, v3_dot(p->fn[f], v[k]));
+        sv -= p->fd[f];
+        if (sv > spec) { m->normal = v3_neg(p->fn[f]); return; }
+        if (sv > sep_f) { sep_f = sv; best_f = f; }
+    }
+    /* edge pairs whose Gauss-map arcs cross: the triangle's edge k spans
+     * the arc from its face normal to its side wall */
+    double sep_e = -1e300;
+    int ek = -1, ej = -1;
+    vec3 en = n;
+    for (int k = 0; k < 3; k++) {
+        vec3 a0 = v[k], da = v3_sub(v[(k + 1) % 3], a0);
+        vec3 na = n, nb = edge_side(v, n, k);
+        vec3 bxa = v3_cross(nb, na);
+        for (int j = 0; j < p->ne; j++) {
+            if (p->ef[j][0] < 0 || p->ef[j][1] < 0) continue;
+            vec3 nc = v3_neg(p->fn[p->ef[j][0]]), nd = v3_neg(p->fn[p->ef[j][1]]);
+            vec3 dxc = v3_cross(nd, nc);
+            double cba = v3_dot(nc, bxa), dba = v3_dot(nd, bxa), adc = v3_dot(na, dxc), bdc = v3_dot(nb, dxc);
+            if (!(cba * dba < 0 && adc * bdc < 0 && cba * bdc > 0)) continue;
+            vec3 b0 = p->v[p->e[j][0]], db = v3_sub(p->v[p->e[j][1]], b0);
+            vec3 ax = v3_cross(da, db);
+            double l2 = v3_len2(ax);
+            if (l2 < 1e-12 * v3_len2(da) * v3_len2(db)) continue;
+            ax = v3_scale(ax, 1.0 / sqrt(l2));
+            if (v3_dot(ax, v3_add(na, nb)) < 0) ax = v3_neg(ax);
+            double sv = v3_dot(ax, v3_sub(b0, a0));
+            if (sv > spec) { m->normal = ax; return; }
+            if (sv > sep_e) { sep_e = sv; ek = k; ej = j; en = ax; }
+        }
+    }
+    const shape *cyl = s->type == SHAPE_CYLINDER ? s : NULL;
+    double face_best = dmax(sep_t, sep_f);
+    if (ek >= 0 && sep_e > face_best + TRI_FACE_TOLERANCE) {
+        if (active >> ek & 1u) {
+            vec3 ca, cb;
+            closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
+            m->normal = en;
+            push_point(m, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
+            return;
+        }
+    } else if (best_f >= 0 && sep_f > sep_t + TRI_FACE_TOLERANCE) {
+        /* the triangle's feature nearest that face: a vertex, an edge or all of it */
+        vec3 nf = v3_neg(p->fn[best_f]);
+        double top = dmax(v3_dot(nf, v[0]), dmax(v3_dot(nf, v[1]), v3_dot(nf, v[2])));
+        double scale = v3_len(v3_sub(v[1], v[0])) + v3_len(v3_sub(v[2], v[0]));
+        int on[3], count = 0;
+        for (int k = 0; k < 3; k++) count += on[k] = top - v3_dot(nf, v[k]) <= 1e-9 * scale;
+        int feature_active = 1;
+        if (count == 1) feature_active = vertex_active(active, on[0] ? 0 : on[1] ? 1 : 2);
+        else if (count == 2) feature_active = (int)(active >> (on[0] && on[1] ? 0 : on[1] && on[2] ? 1 : 2) & 1u);
+        if (feature_active) {
+            poly t;
+            triangle_poly(&t, v, n);
+            poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, m);
+            return;
+        }
+    }
+    /* the triangle's face (also for contacts turned from internal edges) */
+    poly t;
+    triangle_poly(&t, v, n);
+    poly_face_contact(&t, 0, p, cyl, xs, 0, spec, 0, m);
+}
+
+/* Prepared once per pair: the convex shape in world space. */
+typedef struct convex_view {
+    const shape *s;
+    xform x;
+    int is_core;            /* sphere or capsule */
+    vec3 c0, c1;            /* the core */
+    poly p;                 /* box, hull, cylinder */
+} convex_view;
+
+static int convex_view_init(convex_view *cv, const shape *s, xform x)
+{
+    cv->s = s;
+    cv->x = x;
+    cv->is_core = s->type == SHAPE_SPHERE || s->type == SHAPE_CAPSULE;
+    cv->c0 = cv->c1 = x.p;
+    if (s->type == SHAPE_CAPSULE) capsule_segment(s, x, &cv->c0, &cv->c1);
+    if (cv->is_core) return 1;
+    if (!poly_from_shape(&cv->p, s, x)) return 0;
+    poly_edge_faces(&cv->p);
+    return 1;
+}
+
+static void triangle_contact(const convex_view *cv, const vec3 tri[3], unsigned active, int two_sided, double spec,
+                             manifold *m)
+{
+    memset(m, 0, sizeof *m);
+    vec3 v[3] = {tri[0], tri[1], tri[2]};
+    vec3 n = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
+    double len = v3_len(n);
+    m->normal = v3(0, 0, 1);
+    if (!(len > 0) || !isfinite(len)) return;
+    n = v3_scale(n, 1.0 / len);
+    if (two_sided) {
+        /* the side the shape's centre is on is the front */
+        vec3 c = cv->is_core ? v3_scale(v3_add(cv->c0, cv->c1), 0.5) : cv->p.center;
+        if (v3_dot(n, v3_sub(c, v[0])) < 0) {
+            v[1] = tri[2]; v[2] = tri[1];
+            n = v3_neg(n);
+            /* edges now run v0->v2 (was edge 2), v2->v1 (edge 1), v1->v0 (edge 0) */
+            active = ((active >> 2) & 1u) | (active & 2u) | ((active & 1u) << 2);
+        }
+    }
+    if (cv->is_core) triangle_core(v, n, active, cv->c0, cv->c1, cv->s->radius, spec, m);
+    else triangle_polytope(v, n, active, &cv->p, cv->s, cv->x, spec, m);
+}
+
+int collide_triangle(const vec3 v[3], unsigned active, int two_sided, const shape *s, xform xs, double spec, manifold *m)
+{
+    convex_view cv;
+    memset(m, 0, sizeof *m);
+    m->normal = v3(0, 0, 1);
+    if (!convex_view_init(&cv, s, xs)) return 0;
+    triangle_contact(&cv, v, active, two_sided, spec, m);
+    return m->count;
+}
+
+/* ---- many triangles --------------------------------------------------------- */
+
+typedef struct contact_group {
+    vec3 normal;
+    double deepest;
+    int count;
+    manifold_point points[GROUP_CAPACITY];
+} contact_group;
+
+typedef struct composite_query {
+    convex_view cv;
+    xform xm;               /* the mesh's frame */
+    int two_sided;
+    double spec;
+    int max_groups, group_count;
+    contact_group groups[COMPOSITE_MAX_MANIFOLDS];
+} composite_query;
+
+/* Keeps only the corners of the points' outline in the contact plane: the
+ * points clipped at triangle edges inside a face (or along its sides) add
+ * nothing, and left in they could take the place of a true corner in the
+ * reduction, shifting the support and twisting a sliding box. */
+static int outline_corners(manifold_point *pts, int n, vec3 normal)
+{
+    if (n <= 3) return n;
+    vec3 u, w;
+    v3_basis(normal, &u, &w);
+    double x[GROUP_CAPACITY], y[GROUP_CAPACITY];
+    int order[GROUP_CAPACITY], hull[2 * GROUP_CAPACITY];
+    for (int i = 0; i < n; i++) {
+        x[i] = v3_dot(pts[i].point, u);
+        y[i] = v3_dot(pts[i].point, w);
+        order[i] = i;
+    }
+    /* insertion sort by x, then y (n <= 64) */
+    for (int i = 1; i < n; i++) {
+        int k = order[i], j = i - 1;
+        while (j >= 0 && (x[order[j]] > x[k] || (x[order[j]] == x[k] && y[order[j]] > y[k]))) { order[j + 1] = order[j]; j--; }
+        order[j + 1] = k;
+    }
+    double span = fabs(x[order[n - 1]] - x[order[0]]);
+    for (int i = 0; i < n; i++) span = dmax(span, fabs(y[i] - y[order[0]]));
+    double tol = 1e-9 * span * span;
+    /* Andrew's monotone chain; collinear points are dropped */
+    int h = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        int start = h;
+        for (int t = 0; t < n; t++) {
+            int i = pass == 0 ? order[t] : order[n - 1 - t];
+            while (h >= start + 2) {
+                int a = hull[h - 2], b = hull[h - 1];
+                double cr = (x[b] - x[a]) * (y[i] - y[a]) - (y[b] - y[a]) * (x[i] - x[a]);
+                if (cr > tol) break;
+                h--;
+            }
+            hull[h++] = i;
+        }
+        h--; /* the last point starts the other chain */
+    }
+    if (h < 3) return n; /* all on a line: leave them to the reduction */
+    manifold_point kept[GROUP_CAPACITY];
+    for (int i = 0; i < h; i++) kept[i] = pts[hull[i]];
+    for (int i = 0; i < h; i++) pts[i] = kept[i];
+    return h;
+}
+
+static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t index)
+{
+    composite_query *q = ctx;
+    vec3 w[3] = {xf_point(q->xm, v[0]), xf_point(q->xm, v[1]), xf_point(q->xm, v[2])};
+    manifold m;
+    triangle_contact(&q->cv, w, active, q->two_sided, q->spec, &m);
+    if (m.count == 0) return 1;
+    int g = -1;
+    double best = -2;
+    for (int i = 0; i < q->group_count; i++) {
+        double c = v3_dot(q->groups[i].normal, m.normal);
+        if (c > best) { best = c; g = i; }
+    }
+    if (best < GROUP_COS && q->group_count < q->max_groups) {
+        g = q->group_count++;
+        q->groups[g].normal = m.normal;
+        q->groups[g].count = 0;
+        q->groups[g].deepest = 1e300;
+    }
+    contact_group *gr = &q->groups[g];
+    for (int i = 0; i < m.count; i++) {
+        if (gr->count == GROUP_CAPACITY) {
+            gr->count = outline_corners(gr->points, gr->count, gr->normal);
+            if (gr->count > GROUP_CAPACITY / 2) gr->count = manifold_reduce(gr->points, gr->count, gr->normal);
+        }
+        manifold_point mp = m.points[i];
+        /* a vertex of the shape itself on the triangle's face keeps its id
+         * from triangle to triangle (warm starting follows it); other points
+         * are told apart by the triangle */
+        if (mp.id & 0xfff0ff80u) mp.id = (mp.id & 0x3fffffffu) ^ (index * 0x9E3779B1u);
+        if (mp.separation < gr->deepest) {
+            gr->deepest = mp.separation;
+            gr->normal = m.normal; /* the deepest triangle's normal speaks for the group */
+        }
+        gr->points[gr->count++] = mp;
+    }
+    return 1;
+}
+
+int collide_composite(const shape *a, xform xa, const shape *b, xform xb, double spec, manifold *out, int max)
+{
+    int mesh_first = shape_is_composite(a);
+    const shape *ms = mesh_first ? a : b, *cs = mesh_first ? b : a;
+    xform xm = mesh_first ? xa : xb, xc = mesh_first ? xb : xa;
+    if (max > COMPOSITE_MAX_MANIFOLDS) max = COMPOSITE_MAX_MANIFOLDS;
+    if (shape_is_composite(cs) || cs->type == SHAPE_PLANE || max < 1) return 0;
+    composite_query *q = malloc(sizeof *q);
+    if (!q) return 0;
+    if (!convex_view_init(&q->cv, cs, xc)) { free(q); return 0; }
+    q->xm = xm;
+    q->two_sided = ms->type == SHAPE_MESH && ms->mesh->two_sided;
+    q->spec = spec;
+    q->max_groups = max;
+    q->group_count = 0;
+    /* the convex shape's bounds in the mesh's frame */
+    xform rel = {xf_inv_point(xm, xc.p), q_mul(q_conj(xm.q), xc.q)};
+    aabb box = aabb_fatten(shape_aabb(cs, rel), spec > 0 ? spec : 0);
+    if (ms->type == SHAPE_MESH) mesh_query(ms->mesh, box, visit_triangle, q);
+    else heightfield_query(ms->field, box, visit_triangle, q);
+    int n = 0;
+    for (int g = 0; g < q->group_count; g++) {
+        contact_group *gr = &q->groups[g];
+        manifold *m = &out[n++];
+        memset(m, 0, sizeof *m);
+        int c = outline_corners(gr->points, gr->count, gr->normal);
+        c = manifold_reduce(gr->points, c, gr->normal);
+        m->normal = mesh_first ? gr->normal : v3_neg(gr->normal);
+        for (int i = 0; i < c; i++) m->points[i] = gr->points[i];
+        m->count = c;
+    }
+    free(q);
+    return n;
+}

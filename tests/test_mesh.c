@@ -1,0 +1,309 @@
+/* test_mesh.c - triangle meshes and height fields: contacts against one
+ * triangle checked by brute force, bodies sliding and rolling across many
+ * triangles exactly as on a plane, inclines against the analytic answer,
+ * a bullet against a one-triangle wall, and every bad input refused. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+#include "carom/carom.h"
+#include "world.h"
+#include "narrowphase.h"
+#include "mesh.h"
+#include "mesh_scenes.h"
+
+static const carom_quat identity = {1, 0, 0, 0};
+
+typedef enum floor_kind { FLOOR_PLANE, FLOOR_MESH, FLOOR_MESH_RANDOM, FLOOR_FIELD, FLOOR_TILES, FLOOR_PATCHES } floor_kind;
+
+/* The floor's top at z = 0 over [-10, 10]^2 (tiles and patches: 10 x 10 m). */
+static void add_floor(carom_world *w, floor_kind kind)
+{
+    carom_vec3 origin = {0, 0, 0};
+    if (kind == FLOOR_PLANE) {
+        carom_body_def bd = carom_body_def_default();
+        bd.type = CAROM_BODY_STATIC;
+        bd.shape = carom_shape_plane(0, 0, 1, 0);
+        assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+    } else if (kind == FLOOR_MESH || kind == FLOOR_MESH_RANDOM) {
+        double *v; int *t; int nv, nt;
+        scene_grid(20, 1.0, 0.0, kind == FLOOR_MESH_RANDOM ? 7u : 0u, &v, &nv, &t, &nt);
+        assert_int_equal(nt, 800);
+        assert_false(carom_body_id_is_null(scene_add_mesh(w, v, nv, t, nt, origin, identity)));
+        free(v); free(t);
+    } else if (kind == FLOOR_FIELD) {
+        assert_false(carom_body_id_is_null(scene_add_flat_field(w, 21, 21, 1.0, 0.0, origin)));
+    }
+}
+
+typedef struct run_result {
+    carom_vec3 path[601];
+    double max_vz;           /* after the first second */
+} run_result;
+
+/* A box sliding (or a sphere rolling) for 10 s at 60 Hz from (-3, -2.5) along
+ * (1, 0.6): it crosses edges at every angle. */
+static void run_mover(floor_kind kind, int sphere, run_result *r)
+{
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    add_floor(w, kind);
+    carom_body_def bd = carom_body_def_default();
+    double dir_len = sqrt(1 + 0.36);
+    if (sphere) {
+        bd.shape = carom_shape_sphere(0.3);
+        bd.position.z = 0.3;
+        bd.linear_velocity.x = 1.0 / dir_len; bd.linear_velocity.y = 0.6 / dir_len;
+        bd.angular_velocity.x = -bd.linear_velocity.y / 0.3; bd.angular_velocity.y = bd.linear_velocity.x / 0.3;
+    } else {
+        bd.shape = carom_shape_box(0.25, 0.25, 0.25);
+        bd.position.z = 0.25;
+        bd.friction = 0.05 * 0.05 / 0.6; /* mixed with the floor's 0.6: mu = 0.05 */
+        bd.linear_velocity.x = 2.0 / dir_len; bd.linear_velocity.y = 1.2 / dir_len;
+    }
+    bd.position.x = -3; bd.position.y = -2.5;
+    bd.enable_sleep = 0;
+    carom_body_id id = carom_body_create(w, &bd);
+    assert_false(carom_body_id_is_null(id));
+    r->max_vz = 0;
+    for (int i = 0; i <= 600; i++) {
+        if (i > 0) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
+        carom_body_get_position(w, id, &r->path[i]);
+        carom_vec3 v;
+        carom_body_get_linear_velocity(w, id, &v);
+        if (i >= 60 && fabs(v.z) > r->max_vz) r->max_vz = fabs(v.z);
+    }
+    carom_world_destroy(w);
+}
+
+/* Largest distance between the two paths, and the distance travelled. */
+static double path_gap(const run_result *a, const run_result *b, double *travelled)
+{
+    double gap = 0;
+    *travelled = 0;
+    for (int i = 0; i <= 600; i++) {
+        double dx = a->path[i].x - b->path[i].x, dy = a->path[i].y - b->path[i].y, dz = a->path[i].z - b->path[i].z;
+        gap = fmax(gap, sqrt(dx * dx + dy * dy + dz * dz));
+        if (i > 0) {
+            double ex = a->path[i].x - a->path[i - 1].x, ey = a->path[i].y - a->path[i - 1].y;
+            *travelled += sqrt(ex * ex + ey * ey);
+        }
+    }
+    return gap;
+}
+
+static void check_like_plane(floor_kind kind)
+{
+    static run_result plane, other;
+    for (int sphere = 0; sphere < 2; sphere++) {
+        run_mover(FLOOR_PLANE, sphere, &plane);
+        run_mover(kind, sphere, &other);
+        double travelled;
+        double gap = path_gap(&plane, &other, &travelled);
+        printf("  floor %d %s: travelled %.3f m, largest gap to the plane %.3g m, |vz| max %.3g m/s\n", (int)kind,
+               sphere ? "sphere" : "box", travelled, gap, other.max_vz);
+        assert_true(travelled > 3.0);
+        assert_true(gap <= 1e-3 && gap <= 1e-3 * travelled);
+        assert_true(other.max_vz <= 1e-3);
+    }
+}
+
+static void test_flat_mesh_like_plane(void **state) { (void)state; check_like_plane(FLOOR_MESH); }
+static void test_random_diagonals_like_plane(void **state) { (void)state; check_like_plane(FLOOR_MESH_RANDOM); }
+static void test_flat_heightfield_like_plane(void **state) { (void)state; check_like_plane(FLOOR_FIELD); }
+
+/* ---- inclines ----------------------------------------------------------------- */
+
+/* A 20 m incline of angle theta about the y axis, tessellated (random
+ * diagonals), through the origin. */
+static void add_incline(carom_world *w, double theta)
+{
+    double *v; int *t; int nv, nt;
+    scene_grid(20, 1.0, 0.0, 3u, &v, &nv, &t, &nt);
+    carom_quat q = {cos(0.5 * theta), 0, sin(0.5 * theta), 0}; /* theta about y: descends along +x */
+    carom_vec3 o = {0, 0, 0};
+    assert_false(carom_body_id_is_null(scene_add_mesh(w, v, nv, t, nt, o, q)));
+    free(v); free(t);
+}
+
+/* Distance travelled down the slope in time T from rest. */
+static double incline_run(double theta, int sphere, double mu, double T)
+{
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    add_incline(w, theta);
+    carom_body_def bd = carom_body_def_default();
+    double r = 0.3;
+    bd.shape = sphere ? carom_shape_sphere(r) : carom_shape_box(0.25, 0.25, 0.25);
+    double lift = sphere ? r : 0.25;
+    /* resting on the slope at x' = -6 (slope frame), centre lifted along the slope normal */
+    double nx = sin(theta), nz = cos(theta), sx = cos(theta), sz = -sin(theta);
+    bd.position.x = -6 * sx + lift * nx;
+    bd.position.z = -6 * sz + lift * nz;
+    bd.orientation.w = cos(0.5 * theta); bd.orientation.y = sin(0.5 * theta);
+    bd.friction = mu * mu / 0.6; /* mixed with the mesh's 0.6 */
+    bd.enable_sleep = 0;
+    carom_body_id id = carom_body_create(w, &bd);
+    assert_false(carom_body_id_is_null(id));
+    carom_vec3 p0, p1;
+    carom_body_get_position(w, id, &p0);
+    int steps = (int)lround(T * 60);
+    for (int i = 0; i < steps; i++) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
+    carom_body_get_position(w, id, &p1);
+    carom_world_destroy(w);
+    return (p1.x - p0.x) * sx + (p1.z - p0.z) * sz;
+}
+
+static void test_incline_analytic(void **state)
+{
+    (void)state;
+    const double g = 9.81, T = 2.0;
+    double angles[] = {0.2, 0.35};
+    for (int k = 0; k < 2; k++) {
+        double th = angles[k];
+        /* rolling without slipping: a = 5/7 g sin (needs mu >= 2/7 tan) */
+        double s_roll = incline_run(th, 1, 0.6, T), a_roll = 5.0 / 7.0 * g * sin(th);
+        /* sliding box: a = g (sin - mu cos) */
+        double mu = 0.1;
+        double s_slide = incline_run(th, 0, mu, T), a_slide = g * (sin(th) - mu * cos(th));
+        double e_roll = 0.5 * a_roll * T * T, e_slide = 0.5 * a_slide * T * T;
+        printf("  incline %.2f rad: sphere %.4f m (analytic %.4f), box %.4f m (analytic %.4f)\n", th, s_roll, e_roll,
+               s_slide, e_slide);
+        assert_true(fabs(s_roll - e_roll) <= 0.01 * e_roll);
+        assert_true(fabs(s_slide - e_slide) <= 0.01 * e_slide);
+    }
+}
+
+/* ---- a bullet against a wall of one triangle ---------------------------------- */
+
+static void test_bullet_one_triangle_wall(void **state)
+{
+    (void)state;
+    for (int two_sided = 0; two_sided < 2; two_sided++) {
+        carom_world_def wd = carom_world_def_default();
+        wd.gravity.z = 0;
+        carom_world *w = carom_world_create(&wd);
+        /* a triangle in the plane x = 0 facing -x (towards the bullet) */
+        double v[9] = {0, -2, -2, 0, 0, 3, 0, 2, -2};
+        int t[3] = {0, 1, 2};
+        carom_mesh_def md = carom_mesh_def_default();
+        md.vertices = v; md.vertex_count = 3; md.triangles = t; md.triangle_count = 1; md.two_sided = two_sided;
+        carom_body_def bd = carom_body_def_default();
+        bd.type = CAROM_BODY_STATIC;
+        bd.shape.type = CAROM_SHAPE_MESH;
+        bd.mesh = &md;
+        assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+        carom_body_def sd = carom_body_def_default();
+        sd.shape = carom_shape_sphere(0.02);
+        sd.position.x = -5;
+        sd.linear_velocity.x = 750;
+        sd.bullet = 1;
+        carom_body_id b = carom_body_create(w, &sd);
+        for (int i = 0; i < 60; i++) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
+        carom_vec3 p;
+        carom_body_get_position(w, b, &p);
+        printf("  bullet (two_sided %d) ends at x = %.4f\n", two_sided, p.x);
+        assert_true(p.x < 0);
+        carom_world_destroy(w);
+    }
+}
+
+/* ---- bad input ---------------------------------------------------------------- */
+
+static void expect_refused(carom_world *w, const carom_body_def *bd, const char *words)
+{
+    int before = carom_world_body_count(w);
+    carom_body_id id = carom_body_create(w, bd);
+    assert_true(carom_body_id_is_null(id));
+    assert_int_equal(carom_world_body_count(w), before);
+    if (!strstr(carom_world_last_error(w), words)) printf("  message: %s (wanted %s)\n", carom_world_last_error(w), words);
+    assert_non_null(strstr(carom_world_last_error(w), words));
+}
+
+static void test_bad_input_refused(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    double v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    int t[6] = {0, 1, 2, 1, 3, 2};
+    carom_mesh_def md = carom_mesh_def_default();
+    md.vertices = v; md.vertex_count = 4; md.triangles = t; md.triangle_count = 2;
+    carom_body_def bd = carom_body_def_default();
+    bd.type = CAROM_BODY_STATIC;
+    bd.shape.type = CAROM_SHAPE_MESH;
+    bd.mesh = &md;
+    carom_body_id good = carom_body_create(w, &bd);
+    assert_false(carom_body_id_is_null(good));
+    /* a dynamic mesh */
+    bd.type = CAROM_BODY_DYNAMIC;
+    expect_refused(w, &bd, "static or kinematic");
+    assert_int_equal(carom_body_set_type(w, good, CAROM_BODY_DYNAMIC), CAROM_ERROR_UNSUPPORTED);
+    bd.type = CAROM_BODY_STATIC;
+    /* NaN and infinite vertices */
+    v[4] = NAN; expect_refused(w, &bd, "vertices[1]");
+    v[4] = INFINITY; expect_refused(w, &bd, "vertices[1]");
+    v[4] = 0;
+    /* out of range and repeated indices */
+    t[4] = 4; expect_refused(w, &bd, "triangles[1]");
+    t[4] = -1; expect_refused(w, &bd, "triangles[1]");
+    t[4] = 1; expect_refused(w, &bd, "repeats");
+    t[4] = 3;
+    /* only zero-area triangles */
+    double line[9] = {0, 0, 0, 1, 0, 0, 2, 0, 0};
+    int lt[3] = {0, 1, 2};
+    carom_mesh_def flat = md;
+    flat.vertices = line; flat.vertex_count = 3; flat.triangles = lt; flat.triangle_count = 1;
+    bd.mesh = &flat;
+    expect_refused(w, &bd, "zero area");
+    /* empty, missing */
+    flat.triangle_count = 0;
+    expect_refused(w, &bd, "triangles");
+    bd.mesh = NULL;
+    expect_refused(w, &bd, "NULL");
+    /* height fields: NaN height, bad sizes, bad holes, dynamic */
+    double h[9] = {0, 0, 0, 0, NAN, 0, 0, 0, 0};
+    carom_heightfield_def hd = carom_heightfield_def_default();
+    hd.heights = h; hd.rows = 3; hd.columns = 3;
+    bd.shape.type = CAROM_SHAPE_HEIGHTFIELD;
+    bd.heightfield = &hd;
+    expect_refused(w, &bd, "heights[4]");
+    h[4] = 0;
+    hd.rows = 1; expect_refused(w, &bd, "rows");
+    hd.rows = 3;
+    hd.cell_x = 0; expect_refused(w, &bd, "cell");
+    hd.cell_x = 1;
+    int holes[1] = {4};
+    hd.holes = holes; hd.hole_count = 1; expect_refused(w, &bd, "holes[0]");
+    holes[0] = 3;
+    bd.type = CAROM_BODY_DYNAMIC; expect_refused(w, &bd, "static or kinematic");
+    bd.type = CAROM_BODY_STATIC;
+    assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+    assert_int_equal(carom_world_body_count(w), 2);
+    /* degenerate triangles among good ones are dropped, not fatal; an open mesh is fine */
+    double dv[12] = {0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0};
+    int dt[6] = {0, 1, 2, 0, 1, 3};
+    md.vertices = dv; md.triangles = dt;
+    bd.shape.type = CAROM_SHAPE_MESH;
+    bd.mesh = &md;
+    assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+    carom_world_destroy(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_flat_mesh_like_plane),
+        cmocka_unit_test(test_random_diagonals_like_plane),
+        cmocka_unit_test(test_flat_heightfield_like_plane),
+        cmocka_unit_test(test_incline_analytic),
+        cmocka_unit_test(test_bullet_one_triangle_wall),
+        cmocka_unit_test(test_bad_input_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
