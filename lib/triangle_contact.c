@@ -86,14 +86,10 @@ static void triangle_core(const vec3 v[3], vec3 n, unsigned active, vec3 c0, vec
         }
         clip_vertex *t = in; in = out; out = t;
     }
-    if (nb > 0) { /* the core projects onto the face */
-        for (int i = 0; i < nb; i++) {
-            double sep = v3_dot(n, in[i].p) - d - r;
-            if (sep < spec) push_point(m, v3_madd(in[i].p, -(r + 0.5 * sep), n), sep, in[i].id & 0xffffu);
-        }
-        return;
-    }
-    /* nearest edge or vertex */
+    double face_sep = 1e300;
+    for (int i = 0; i < nb; i++) face_sep = dmin(face_sep, v3_dot(n, in[i].p) - d - r);
+    /* nearest edge or vertex (a capsule partly over the face can still be
+     * nearest to an edge) */
     double best = 1e300, best_s = 0;
     vec3 q = v[0], pc = c0;
     int bk = 0;
@@ -110,6 +106,14 @@ static void triangle_core(const vec3 v[3], vec3 n, unsigned active, vec3 c0, vec
     int feature_active = best_s <= 1e-9 ? vertex_active(active, bk)
                        : best_s >= 1 - 1e-9 ? vertex_active(active, (bk + 1) % 3) : (int)(active >> bk & 1u);
     double dist = sqrt(best);
+    if (nb > 0 && !(feature_active && dist - r < face_sep - 1e-12 && dist > 1e-12)) {
+        /* the core over the face, nearest to it */
+        for (int i = 0; i < nb; i++) {
+            double sep = v3_dot(n, in[i].p) - d - r;
+            if (sep < spec) push_point(m, v3_madd(in[i].p, -(r + 0.5 * sep), n), sep, in[i].id & 0xffffu);
+        }
+        return;
+    }
     vec3 nrm;
     double sep;
     if (!feature_active || dist < 1e-12) {
@@ -122,6 +126,34 @@ static void triangle_core(const vec3 v[3], vec3 n, unsigned active, vec3 c0, vec
     }
     m->normal = nrm;
     if (sep < spec) push_point(m, v3_madd(pc, -(r + 0.5 * sep), nrm), sep, 0x100u + (uint32_t)bk);
+}
+
+/* A cylinder's prism lies inside the true rim: add the true rim's deepest
+ * point when it lies over the triangle (as the plane contact does). */
+static void add_rim_point(const vec3 v[3], vec3 n, const shape *cyl, xform x, double spec, manifold *m)
+{
+    vec3 axis = q_rotate(x.q, v3(0, 0, 1));
+    vec3 radial = v3_madd(v3_neg(n), v3_dot(n, axis), axis);
+    if (v3_len2(radial) < 1e-12) return; /* the cap lies flat: its polygon is exact */
+    radial = v3_normalize(radial);
+    double hz = v3_dot(axis, n) > 0 ? -cyl->half_height : cyl->half_height;
+    vec3 p = v3_add(v3_madd(x.p, hz, axis), v3_scale(radial, cyl->radius));
+    for (int k = 0; k < 3; k++) {
+        vec3 side = edge_side(v, n, k);
+        if (v3_dot(side, p) > v3_dot(side, v[k])) return;
+    }
+    double sep = v3_dot(n, p) - v3_dot(n, v[0]);
+    if (!(sep < spec)) return;
+    manifold_point pts[MANIFOLD_MAX_POINTS + 1];
+    int c = m->count;
+    for (int i = 0; i < c; i++) pts[i] = m->points[i];
+    pts[c].point = v3_madd(p, -0.5 * sep, n);
+    pts[c].separation = sep;
+    pts[c].id = 0x60u;
+    c = manifold_reduce(pts, c + 1, n);
+    for (int i = 0; i < c; i++) m->points[i] = pts[i];
+    m->count = c;
+    m->normal = n;
 }
 
 /* A polytope p (built from shape s at xs; edge faces filled) against the triangle. */
@@ -172,17 +204,25 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
             if (sv > sep_e) { sep_e = sv; ek = k; ej = j; en = ax; }
         }
     }
+    /* the triangle's face first (a resting shape keeps it, and contacts from
+     * internal edges are turned to it) */
     const shape *cyl = s->type == SHAPE_CYLINDER ? s : NULL;
-    double face_best = dmax(sep_t, sep_f);
-    if (ek >= 0 && sep_e > face_best + TRI_FACE_TOLERANCE) {
-        if (active >> ek & 1u) {
-            vec3 ca, cb;
-            closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
-            m->normal = en;
-            push_point(m, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
-            return;
-        }
-    } else if (best_f >= 0 && sep_f > sep_t + TRI_FACE_TOLERANCE) {
+    poly t;
+    triangle_poly(&t, v, n);
+    poly_face_contact(&t, 0, p, cyl, xs, 0, spec, 0, m);
+    if (cyl) add_rim_point(v, n, s, xs, spec, m);
+    /* another axis that separates more, from an active feature of the
+     * triangle, replaces it when its contact is nearer: the face's points,
+     * clipped to the triangle, can miss the shape's nearest corner */
+    manifold alt;
+    memset(&alt, 0, sizeof alt);
+    if (ek >= 0 && sep_e > dmax(sep_t, sep_f) + TRI_FACE_TOLERANCE && (active >> ek & 1u)) {
+        vec3 ca, cb;
+        closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
+        alt.normal = en;
+        push_point(&alt, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
+    } else if (best_f >= 0 && sep_f > sep_t + TRI_FACE_TOLERANCE && !(ek >= 0 && sep_e > sep_f + TRI_FACE_TOLERANCE) &&
+               !(cyl && best_f < CYL_SIDES)) { /* a prism facet only approximates a round side */
         /* the triangle's feature nearest that face: a vertex, an edge or all of it */
         vec3 nf = v3_neg(p->fn[best_f]);
         double top = dmax(v3_dot(nf, v[0]), dmax(v3_dot(nf, v[1]), v3_dot(nf, v[2])));
@@ -192,17 +232,15 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
         int feature_active = 1;
         if (count == 1) feature_active = vertex_active(active, on[0] ? 0 : on[1] ? 1 : 2);
         else if (count == 2) feature_active = (int)(active >> (on[0] && on[1] ? 0 : on[1] && on[2] ? 1 : 2) & 1u);
-        if (feature_active) {
-            poly t;
-            triangle_poly(&t, v, n);
-            poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, m);
-            return;
-        }
+        if (feature_active) poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, &alt);
     }
-    /* the triangle's face (also for contacts turned from internal edges) */
-    poly t;
-    triangle_poly(&t, v, n);
-    poly_face_contact(&t, 0, p, cyl, xs, 0, spec, 0, m);
+    if (alt.count > 0) *m = alt;
+    /* apart: points clipped to a reference face can miss the nearest corner
+     * of the other side; the separating axes bound the distance from below,
+     * so no point may claim more room than they do */
+    double bound = dmax(sep_t, dmax(sep_f, sep_e));
+    if (bound > 0)
+        for (int i = 0; i < m->count; i++) m->points[i].separation = dmin(m->points[i].separation, bound);
 }
 
 /* Prepared once per pair: the convex shape in world space. */
