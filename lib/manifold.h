@@ -31,6 +31,11 @@ typedef struct clip_vertex {
 /* Clips polygon in[0..n) to dot(plane_n, p) <= plane_d; out needs n + 1 slots. */
 int clip_polygon(const clip_vertex *in, int n, vec3 plane_n, double plane_d, uint32_t edge_tag, clip_vertex *out);
 
+/* Keeps only the corners of the points' outline seen along normal (at most
+ * 64 points; collinear and inner points dropped, order along the outline);
+ * returns the new count. triangle_contact.c. */
+int manifold_outline(manifold_point *pts, int n, vec3 normal);
+
 /* narrowphase.c's polytope helpers, shared with the triangle contacts. */
 int poly_from_shape(poly *p, const shape *s, xform x);   /* box, hull, cylinder (a prism); 0 otherwise */
 void poly_finish(poly *p);                               /* centre and face offsets from v, fn, fv */

@@ -321,9 +321,9 @@ typedef struct composite_query {
  * points clipped at triangle edges inside a face (or along its sides) add
  * nothing, and left in they could take the place of a true corner in the
  * reduction, shifting the support and twisting a sliding box. */
-static int outline_corners(manifold_point *pts, int n, vec3 normal)
+int manifold_outline(manifold_point *pts, int n, vec3 normal)
 {
-    if (n <= 3) return n;
+    if (n <= 3 || n > GROUP_CAPACITY) return n;
     vec3 u, w;
     v3_basis(normal, &u, &w);
     double x[GROUP_CAPACITY], y[GROUP_CAPACITY];
@@ -387,7 +387,7 @@ static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t 
     contact_group *gr = &q->groups[g];
     for (int i = 0; i < m.count; i++) {
         if (gr->count == GROUP_CAPACITY) {
-            gr->count = outline_corners(gr->points, gr->count, gr->normal);
+            gr->count = manifold_outline(gr->points, gr->count, gr->normal);
             if (gr->count > GROUP_CAPACITY / 2) gr->count = manifold_reduce(gr->points, gr->count, gr->normal);
         }
         manifold_point mp = m.points[i];
@@ -429,7 +429,7 @@ int collide_composite(const shape *a, xform xa, const shape *b, xform xb, double
         contact_group *gr = &q->groups[g];
         manifold *m = &out[n++];
         memset(m, 0, sizeof *m);
-        int c = outline_corners(gr->points, gr->count, gr->normal);
+        int c = manifold_outline(gr->points, gr->count, gr->normal);
         c = manifold_reduce(gr->points, c, gr->normal);
         m->normal = mesh_first ? gr->normal : v3_neg(gr->normal);
         for (int i = 0; i < c; i++) m->points[i] = gr->points[i];

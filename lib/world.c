@@ -286,6 +286,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     int ok = world_update_pairs(w);
     double t2 = now_ms();
     if (ok) ok = world_collide(w);
+    if (ok) world_remove_ghost_contacts(w);
     double t3 = now_ms();
     if (ok) ok = world_solve(w, dt);
     double t4 = now_ms();

@@ -12,6 +12,7 @@
 #include <math.h>
 #include "narrowphase.h"
 #include "shape.h"
+#include "mesh.h"
 
 #define PI 3.14159265358979323846
 
@@ -851,15 +852,30 @@ static void test_box_box_pinned_ids(void **state)
                  take_a);
 }
 
+/* A bumpy two-sided mesh and a height field with a hole, both about 1 m. */
+static void add_level_shapes(shape *shapes)
+{
+    double v[15] = {-0.6, -0.6, 0, 0.6, -0.6, 0.1, 0.6, 0.6, -0.1, -0.6, 0.6, 0.2, 0, 0, 0.3};
+    int t[12] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+    char err[128];
+    shapes[SHAPE_MESH].mesh = mesh_build(v, 5, t, 4, 1, err, (int)sizeof err);
+    assert_non_null(shapes[SHAPE_MESH].mesh);
+    double h[16] = {0, 0.1, 0, 0.2, 0.1, 0.3, -0.1, 0, 0, 0.2, 0.1, 0, 0.3, 0, 0.1, 0};
+    int hole = 4;
+    shapes[SHAPE_HEIGHTFIELD].field = heightfield_build(h, 4, 4, 0.4, 0.4, &hole, 1, err, (int)sizeof err);
+    assert_non_null(shapes[SHAPE_HEIGHTFIELD].field);
+}
+
 /* ---- 5. every pair of shape types stays finite ----------------------------------- */
 
 static void test_every_pair_is_finite(void **state)
 {
     (void)state;
     double pts[21] = {0.3, 0, 0, -0.3, 0, 0, 0, 0.3, 0, 0, -0.3, 0, 0, 0, 0.4, 0, 0, -0.4, 0.1, 0.1, 0.1};
-    shape shapes[6] = {sphere(0.4), box(0.3, 0.4, 0.5), capsule(0.2, 0.4), cylinder(0.35, 0.3), make(SHAPE_HULL),
-                       ground()};
+    shape shapes[SHAPE_TYPE_COUNT] = {sphere(0.4), box(0.3, 0.4, 0.5), capsule(0.2, 0.4), cylinder(0.35, 0.3),
+                                      make(SHAPE_HULL), ground(), make(SHAPE_MESH), make(SHAPE_HEIGHTFIELD)};
     shapes[4] = hull_shape(pts, 7);
+    add_level_shapes(shapes);
     const uint64_t seed = 0xF1A17E5EEDULL;
     uint64_t s = seed;
     for (int a = 0; a < SHAPE_TYPE_COUNT; a++)
@@ -881,7 +897,7 @@ static void test_every_pair_is_finite(void **state)
                     fail();
                 }
             }
-    hull_free(shapes[4].hull);
+    for (int i = 0; i < SHAPE_TYPE_COUNT; i++) shape_free_data(&shapes[i]);
 }
 
 /* A pose that overflowed (inf/NaN position or rotation) gives no contact for
@@ -890,9 +906,10 @@ static void test_non_finite_poses_give_no_contact(void **state)
 {
     (void)state;
     double pts[21] = {0.3, 0, 0, -0.3, 0, 0, 0, 0.3, 0, 0, -0.3, 0, 0, 0, 0.4, 0, 0, -0.4, 0.1, 0.1, 0.1};
-    shape shapes[6] = {sphere(0.4), box(0.3, 0.4, 0.5), capsule(0.2, 0.4), cylinder(0.35, 0.3), make(SHAPE_HULL),
-                       ground()};
+    shape shapes[SHAPE_TYPE_COUNT] = {sphere(0.4), box(0.3, 0.4, 0.5), capsule(0.2, 0.4), cylinder(0.35, 0.3),
+                                      make(SHAPE_HULL), ground(), make(SHAPE_MESH), make(SHAPE_HEIGHTFIELD)};
     shapes[4] = hull_shape(pts, 7);
+    add_level_shapes(shapes);
     const double bad[3] = {NAN, INFINITY, -INFINITY};
     for (int a = 0; a < SHAPE_TYPE_COUNT; a++)
         for (int b = 0; b < SHAPE_TYPE_COUNT; b++)
@@ -909,7 +926,7 @@ static void test_non_finite_poses_give_no_contact(void **state)
                 assert_int_equal(m.count, 0);
                 assert_true(v3_is_finite(m.normal));
             }
-    hull_free(shapes[4].hull);
+    for (int i = 0; i < SHAPE_TYPE_COUNT; i++) shape_free_data(&shapes[i]);
 }
 
 int main(void)

@@ -1,0 +1,230 @@
+/* ghost.c - ghost contacts between separate static bodies. A box sliding
+ * from one floor tile onto the next touches the next tile's side face (or
+ * the next mesh patch's boundary edge) before its top face: a contact whose
+ * normal pushes it back, though the two tiles make one flat floor. Active
+ * edges cannot see this (the tiles are separate bodies), so after the
+ * narrowphase each dynamic body's manifolds against static and kinematic
+ * bodies are compared pairwise: manifold j is a ghost of manifold i when
+ * their normals differ, j's body does not rise above the plane i touches
+ * (along i's normal it reaches no farther than i's body), while along j's
+ * normal i's body does reach farther than j's (so j's normal is not the
+ * normal of a common surface). A ghost is left out of this step's solve;
+ * the surface it lies under holds the body. A true step (a tile higher
+ * than its neighbour by more than a tenth of the linear slop) or a wall
+ * standing on the floor rises above the floor's plane and keeps its contact.
+ *
+ * Then the manifolds a dynamic body has with several static bodies on one
+ * plane (the same normal and offset, the same mixed friction and
+ * restitution) are solved as one: their points, outline corners first,
+ * reduced to four, each keeping its warm-start impulses. Static bodies do
+ * not move, so which one a point belongs to does not matter to the solver,
+ * and a box over four tiles is then held exactly as on one plane, not by
+ * sixteen points whose iterative solution twists it. */
+#include <stdlib.h>
+#include <string.h>
+#include "world.h"
+#include "manifold.h"
+
+#define GHOST_COS (1.0 - 1e-12) /* normals this close are one surface's (the reach test decides the rest) */
+
+typedef struct ghost_entry {
+    int dynamic, other;    /* id indices */
+    int contact;           /* index into the contact set */
+    int listed;            /* index into the touching list */
+    vec3 normal;           /* from the other body towards the dynamic one */
+} ghost_entry;
+
+static int by_dynamic(const void *x, const void *y)
+{
+    const ghost_entry *a = x, *b = y;
+    if (a->dynamic != b->dynamic) return a->dynamic < b->dynamic ? -1 : 1;
+    if (a->other != b->other) return a->other < b->other ? -1 : 1; /* the same order every step */
+    return a->contact < b->contact ? -1 : (a->contact > b->contact);
+}
+
+/* How far the shape reaches along unit direction n: max over it of dot(n, x). */
+static double reach_along(const shape *s, xform x, vec3 n)
+{
+    if (s->type == SHAPE_PLANE) {
+        vec3 pn = q_rotate(x.q, s->plane_normal);
+        if (v3_dot(pn, n) < 1.0 - 1e-9) return INFINITY; /* a plane reaches without end except along its normal */
+        return s->plane_offset + v3_dot(pn, x.p);
+    }
+    if (shape_is_composite(s)) {
+        /* the bounds' corners: exact for flat patches, an over-estimate for hills
+         * (which then keep their contacts, as without this pass) */
+        aabb b = shape_aabb(s, x);
+        return (n.x > 0 ? b.hi.x : b.lo.x) * n.x + (n.y > 0 ? b.hi.y : b.lo.y) * n.y + (n.z > 0 ? b.hi.z : b.lo.z) * n.z;
+    }
+    return v3_dot(n, xf_point(x, shape_support_local(s, q_inv_rotate(x.q, n))));
+}
+
+/* A contact left out of the solve: its impulses are not this step's, so
+ * they must not warm-start it when it is solved again, and its manifold
+ * must be recomputed. */
+static void unsolved(contact_set *cs, int ci)
+{
+    contact_data *d = &cs->data[ci];
+    for (int k = 0; k < MANIFOLD_MAX_POINTS; k++) {
+        d->state[k].normal_impulse = 0;
+        d->state[k].tangent_impulse[0] = d->state[k].tangent_impulse[1] = 0;
+    }
+    cs->items[ci].flags &= ~(uint32_t)CONTACT_REUSABLE;
+}
+
+#define MERGE_COS (1.0 - 1e-9)
+#define MERGE_MAX 64
+
+/* Offset of the static surface under a manifold's first point, along n
+ * (from the static body to the dynamic one): the point lies midway. */
+static double surface_offset(const manifold *m, vec3 n)
+{
+    return v3_dot(n, m->points[0].point) - 0.5 * m->points[0].separation;
+}
+
+/* Merges, per dynamic body, the manifolds against static bodies on one plane
+ * into the first of them (entries sorted by dynamic body, ghosts unlisted).
+ * Returns how many manifolds were taken off the touching list. */
+static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    int removed = 0;
+    for (int first = 0; first < n;) {
+        int last = first + 1;
+        while (last < n && e[last].dynamic == e[first].dynamic) last++;
+        for (int i = first; i < last && last - first > 1; i++) {
+            if (e[i].listed < 0 || s->type[s->ids[e[i].other].slot] != CAROM_BODY_STATIC) continue;
+            contact_data *di = &cs->data[e[i].contact];
+            if (di->m.count == 0) continue;
+            double hi = surface_offset(&di->m, e[i].normal);
+            manifold_point pts[MERGE_MAX];
+            contact_point_state st[MERGE_MAX];
+            int group[MERGE_MAX];
+            int np = 0, merged = 0;
+            for (int k = 0; k < di->m.count; k++) { pts[np] = di->m.points[k]; st[np] = di->state[k]; np++; }
+            for (int j = i + 1; j < last; j++) {
+                if (e[j].listed < 0 || e[j].other == e[i].other) continue;
+                if (s->type[s->ids[e[j].other].slot] != CAROM_BODY_STATIC) continue;
+                contact_data *dj = &cs->data[e[j].contact];
+                if (dj->m.count == 0 || np + dj->m.count > MERGE_MAX) continue;
+                if (v3_dot(e[i].normal, e[j].normal) < MERGE_COS) continue;
+                if (dj->friction != di->friction || dj->restitution != di->restitution) continue;
+                if (fabs(surface_offset(&dj->m, e[j].normal) - hi) > tol) continue;
+                /* friction impulses carry over only in the same tangent basis */
+                int same_basis = v3_dot(di->tangent1, dj->tangent1) > 0.999;
+                for (int k = 0; k < dj->m.count; k++) {
+                    pts[np] = dj->m.points[k];
+                    st[np] = dj->state[k];
+                    if (!same_basis) st[np].tangent_impulse[0] = st[np].tangent_impulse[1] = 0;
+                    np++;
+                }
+                sc->touching[e[j].listed] = -1;
+                e[j].listed = -1;
+                cs->items[e[j].contact].flags &= ~(uint32_t)CONTACT_REUSABLE;
+                group[merged++] = j;
+            }
+            if (!merged) continue;
+            removed += merged;
+            /* reduce, carrying each point's state: the candidate index rides in the id */
+            uint32_t ids[MERGE_MAX];
+            manifold_point all[MERGE_MAX];
+            for (int k = 0; k < np; k++) { all[k] = pts[k]; ids[k] = pts[k].id; pts[k].id = (uint32_t)k; }
+            vec3 mn = di->m.normal;
+            int c = manifold_outline(pts, np, mn);
+            c = manifold_reduce(pts, c, mn);
+            contact_point_state kept[MANIFOLD_MAX_POINTS];
+            for (int k = 0; k < c; k++) {
+                /* where bodies meet, several give the same point: keep the state
+                 * that carries the most (the others may be fresh) */
+                int src = (int)pts[k].id;
+                for (int q = 0; q < np; q++)
+                    if (v3_len2(v3_sub(all[q].point, all[src].point)) < 1e-12 &&
+                        fabs(st[q].normal_impulse) > fabs(st[src].normal_impulse))
+                        src = q;
+                kept[k] = st[src];
+                pts[k].id = ids[pts[k].id];
+            }
+            for (int k = 0; k < c; k++) { di->m.points[k] = pts[k]; di->state[k] = kept[k]; }
+            di->m.count = c;
+            /* this step's manifold is no longer the narrowphase's own: recompute it next step */
+            cs->items[e[i].contact].flags &= ~(uint32_t)CONTACT_REUSABLE;
+            /* the others remember it too: whichever leads next step warm-starts from it */
+            for (int g = 0; g < merged; g++) {
+                contact_data *dj = &cs->data[e[group[g]].contact];
+                vec3 nj = dj->m.normal;
+                dj->m = di->m;
+                dj->m.normal = v3_dot(nj, mn) < 0 ? v3_neg(mn) : mn;
+                for (int k = 0; k < c; k++) dj->state[k] = kept[k];
+            }
+        }
+        first = last;
+    }
+    return removed;
+}
+
+void world_remove_ghost_contacts(carom_world *w)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    int n = 0;
+    for (int k = 0; k < sc->touching_count; k++) {
+        const contact *c = &cs->items[sc->touching[k]];
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        n += (s->type[a] == CAROM_BODY_DYNAMIC) != (s->type[b] == CAROM_BODY_DYNAMIC);
+    }
+    if (n < 2) return;
+    ghost_entry *e = malloc(sizeof *e * (size_t)n);
+    if (!e) return; /* out of memory: the ghosts stay, as they would without this pass */
+    n = 0;
+    for (int k = 0; k < sc->touching_count; k++) {
+        int ci = sc->touching[k];
+        const contact *c = &cs->items[ci];
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        int da = s->type[a] == CAROM_BODY_DYNAMIC, db = s->type[b] == CAROM_BODY_DYNAMIC;
+        if (da == db) continue;
+        /* the manifold's normal points from a to b */
+        vec3 normal = da ? v3_neg(cs->data[ci].m.normal) : cs->data[ci].m.normal;
+        ghost_entry g = {da ? c->id_a : c->id_b, da ? c->id_b : c->id_a, ci, k, normal};
+        e[n++] = g;
+    }
+    qsort(e, (size_t)n, sizeof *e, by_dynamic);
+    double tol = 0.1 * w->def.linear_slop;
+    int removed = 0;
+    for (int first = 0; first < n;) {
+        int last = first + 1;
+        while (last < n && e[last].dynamic == e[first].dynamic) last++;
+        for (int j = first; j < last && last - first > 1; j++) {
+            const ghost_entry *gj = &e[j];
+            int sj = s->ids[gj->other].slot;
+            xform xj = body_xform(s, sj);
+            for (int i = first; i < last; i++) {
+                const ghost_entry *gi = &e[i];
+                if (i == j || gi->other == gj->other || gi->listed < 0) continue;
+                if (v3_dot(gi->normal, gj->normal) >= GHOST_COS) continue;
+                int si = s->ids[gi->other].slot;
+                xform xi = body_xform(s, si);
+                /* j's body stays under i's plane, and j's normal is not a common surface's */
+                if (!(reach_along(&s->shapes[sj], xj, gi->normal) <= reach_along(&s->shapes[si], xi, gi->normal) + tol))
+                    continue;
+                if (reach_along(&s->shapes[si], xi, gj->normal) <= reach_along(&s->shapes[sj], xj, gj->normal) + tol)
+                    continue;
+                sc->touching[gj->listed] = -1;
+                e[j].listed = -1;
+                unsolved(cs, e[j].contact);
+                removed++;
+                break;
+            }
+        }
+        first = last;
+    }
+    removed += merge_coplanar(w, e, n, tol);
+    free(e);
+    if (!removed) return;
+    int kept = 0;
+    for (int k = 0; k < sc->touching_count; k++)
+        if (sc->touching[k] >= 0) sc->touching[kept++] = sc->touching[k];
+    sc->touching_count = kept;
+}
