@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mesh.h"
+#include "ranges.h"
 
 void heightfield_free(height_field *h)
 {
@@ -23,10 +24,13 @@ height_field *heightfield_build(const double *heights, int rows, int columns, do
     if (rows < 2 || columns < 2) HF_FAIL("heightfield rows and columns: need at least 2 each (got %d x %d)", rows, columns);
     if ((double)rows * columns > 1e8) HF_FAIL("heightfield: too large (%d x %d)", rows, columns);
     if (!heights) HF_FAIL("heightfield heights: NULL");
-    if (!(isfinite(cell_x) && cell_x > 0 && isfinite(cell_y) && cell_y > 0))
-        HF_FAIL("heightfield cell: sizes must be positive and finite (got %g, %g)", cell_x, cell_y);
+    if (!(cell_x >= RANGE_LENGTH_MIN && cell_x <= RANGE_LENGTH_MAX && cell_y >= RANGE_LENGTH_MIN && cell_y <= RANGE_LENGTH_MAX))
+        HF_FAIL("heightfield cell: sizes must be in [1e-6, 1e6] m (got %g, %g)", cell_x, cell_y);
+    if ((columns - 1) * cell_x > RANGE_LENGTH_MAX || (rows - 1) * cell_y > RANGE_LENGTH_MAX)
+        HF_FAIL("heightfield: wider than 1e6 m (%g x %g)", (columns - 1) * cell_x, (rows - 1) * cell_y);
     for (int i = 0; i < rows * columns; i++)
-        if (!isfinite(heights[i]) || fabs(heights[i]) > 1e12) HF_FAIL("heightfield heights[%d]: must be finite", i);
+        if (!isfinite(heights[i]) || fabs(heights[i]) > RANGE_LENGTH_MAX)
+            HF_FAIL("heightfield heights[%d]: must be finite (within 1e6 m)", i);
     int cells = (rows - 1) * (columns - 1);
     if (hole_count < 0 || (hole_count > 0 && !holes)) HF_FAIL("heightfield holes: bad list (count %d)", hole_count);
     for (int i = 0; i < hole_count; i++)

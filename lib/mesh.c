@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "mesh.h"
+#include "ranges.h"
 
 #define LEAF_SIZE 4
 #define SAH_BINS 16
@@ -244,8 +245,8 @@ tri_mesh *mesh_build(const double *vertices, int vertex_count, const int *triang
     if (!triangles || triangle_count < 1) { fail(err, err_size, "mesh triangles: need at least 1 (got %d)", triangle_count, 0); return NULL; }
     if (vertex_count > 100000000 || triangle_count > 100000000) { fail(err, err_size, "mesh: too large (%d vertices, %d triangles)", vertex_count, triangle_count); return NULL; }
     for (int i = 0; i < 3 * vertex_count; i++)
-        if (!isfinite(vertices[i]) || fabs(vertices[i]) > 1e12) {
-            fail(err, err_size, "mesh vertices[%d]: coordinates must be finite (within 1e12)", i / 3, 0);
+        if (!isfinite(vertices[i]) || fabs(vertices[i]) > RANGE_LENGTH_MAX) {
+            fail(err, err_size, "mesh vertices[%d]: coordinates must be finite (within 1e6 m)", i / 3, 0);
             return NULL;
         }
     for (int t = 0; t < triangle_count; t++) {
