@@ -37,8 +37,8 @@ int ray_triangle(vec3 o, vec3 d, const vec3 v[3], int two_sided, double max_t, d
     vec3 e1 = v3_sub(v[1], v[0]), e2 = v3_sub(v[2], v[0]);
     vec3 pv = v3_cross(d, e2);
     double det = v3_dot(e1, pv);
-    /* det < 0: the ray meets the front face (normal e1 x e2 against d) */
-    if (!two_sided && !(det < 0)) return 0;
+    /* det = -d . (e1 x e2) > 0: the ray meets the front face */
+    if (!two_sided && !(det > 0)) return 0;
     if (det == 0 || !isfinite(det)) return 0;
     double inv = 1.0 / det;
     vec3 tv = v3_sub(o, v[0]);

@@ -49,7 +49,10 @@ typedef struct clua_body {
 /* A shape descriptor: an immutable, validated carom_shape_def. */
 typedef struct clua_shape {
     carom_shape_def def;
-    double *points; /* hull points (owned; the world copies them at add_body) */
+    double *points; /* hull points, mesh vertices, heights (owned; the world copies them at add_body) */
+    int *indices;   /* mesh triangles (0-based), height field holes (owned) */
+    carom_mesh_def mesh;               /* mesh: points over indices */
+    carom_heightfield_def heightfield; /* heightfield: points and indices */
 } clua_shape;
 
 /* ---- errors and arguments (carom_lua.c) ---------------------------------- */

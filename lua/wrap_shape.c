@@ -11,7 +11,7 @@
 #include "carom_lua.h"
 #include "ranges.h"
 
-const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", NULL};
+const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", "mesh", "heightfield", NULL};
 
 /* Largest hull input accepted here; the world refuses hulls whose result is
  * larger than its narrowphase holds, with its own message. */
@@ -20,7 +20,7 @@ const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", 
 clua_shape *clua_check_shape(lua_State *L, int arg, const char *fname)
 {
     clua_shape *s = luaL_testudata(L, arg, CLUA_SHAPE_MT);
-    if (!s) clua_type_error(L, arg, fname, "shape (carom.sphere, box, capsule, cylinder, hull or plane)");
+    if (!s) clua_type_error(L, arg, fname, "shape (carom.sphere, box, capsule, cylinder, hull, plane, mesh or heightfield)");
     return s;
 }
 
@@ -176,13 +176,168 @@ static int l_plane(lua_State *L)
     return 1;
 }
 
+/* ---- level geometry ---------------------------------------------------------- */
+
+/* Reads the list at index t as n groups of `width` numbers: either a list of
+ * groups ({{x, y, z}, ...}) or a flat list of numbers. Returns n; out is
+ * malloc'ed (what = the field's name, for errors). */
+static int read_groups(lua_State *L, const char *fname, const char *what, int t, int width, double **out)
+{
+    lua_Integer len = (lua_Integer)lua_rawlen(L, t);
+    int nested = len > 0 && lua_rawgeti(L, t, 1) == LUA_TTABLE;
+    lua_settop(L, lua_gettop(L) - (len > 0 ? 1 : 0));
+    if (!nested && len % width != 0)
+        clua_arg_error(L, 1, fname, "%s: a flat list needs a multiple of %d numbers, got %d", what, width, (int)len);
+    lua_Integer n = nested ? len : len / width;
+    if (n > 100000000) clua_arg_error(L, 1, fname, "%s: too many entries (%lld)", what, (long long)n);
+    double *v = malloc(sizeof *v * (size_t)(n > 0 ? n : 1) * (size_t)width);
+    if (!v) return luaL_error(L, "%s: out of memory", fname);
+    for (lua_Integer i = 0; i < n; i++) {
+        if (nested) {
+            if (lua_rawgeti(L, t, i + 1) != LUA_TTABLE || lua_rawlen(L, -1) != (size_t)width) {
+                free(v);
+                clua_arg_error(L, 1, fname, "%s[%d] is not a list of %d numbers", what, (int)i + 1, width);
+            }
+            for (int c = 0; c < width; c++) {
+                if (lua_rawgeti(L, -1, c + 1) != LUA_TNUMBER) {
+                    free(v);
+                    clua_arg_error(L, 1, fname, "%s[%d] is not a list of %d numbers", what, (int)i + 1, width);
+                }
+                v[width * i + c] = lua_tonumber(L, -1);
+                lua_pop(L, 1);
+            }
+            lua_pop(L, 1);
+        } else {
+            for (int c = 0; c < width; c++) {
+                if (lua_rawgeti(L, t, width * i + c + 1) != LUA_TNUMBER) {
+                    free(v);
+                    clua_arg_error(L, 1, fname, "%s[%d] is not a number", what, (int)(width * i + c) + 1);
+                }
+                v[width * i + c] = lua_tonumber(L, -1);
+                lua_pop(L, 1);
+            }
+        }
+    }
+    *out = v;
+    return (int)n;
+}
+
+/* The 1-based integers in v (n of them) as 0-based ints below limit. */
+static int *to_indices(lua_State *L, const char *fname, const char *what, double *v, int n, int limit, int width)
+{
+    int *ix = malloc(sizeof *ix * (size_t)(n > 0 ? n : 1));
+    if (!ix) { free(v); luaL_error(L, "%s: out of memory", fname); return NULL; }
+    for (int i = 0; i < n; i++) {
+        double x = v[i];
+        if (!(x == floor(x) && x >= 1 && x <= limit)) {
+            char num[32];
+            snprintf(num, sizeof num, "%.17g", x);
+            free(ix);
+            free(v);
+            if (width > 1) clua_arg_error(L, 1, fname, "%s[%d]: index %s is not an integer in 1..%d", what, i / width + 1, num, limit);
+            else clua_arg_error(L, 1, fname, "%s[%d]: %s is not an integer in 1..%d", what, i + 1, num, limit);
+        }
+        ix[i] = (int)x - 1;
+    }
+    free(v);
+    return ix;
+}
+
+/* carom.mesh{vertices = {{x, y, z}, ...}, triangles = {{i, j, k}, ...}, two_sided = false}:
+ * 1-based indices, counter-clockwise seen from the front; flat number lists too. */
+static int l_mesh(lua_State *L)
+{
+    static const char *const keys[] = {"vertices", "triangles", "two_sided", NULL};
+    check_shape_args(L, "mesh", keys);
+    normalise_positions(L, "mesh", keys);
+    if (clua_rawfield(L, 1, "vertices") != LUA_TTABLE) clua_arg_error(L, 1, "mesh", "vertices must be a list of {x, y, z}");
+    if (clua_rawfield(L, 1, "triangles") != LUA_TTABLE) clua_arg_error(L, 1, "mesh", "triangles must be a list of {i, j, k}");
+    int two_sided = 0;
+    clua_field_bool(L, 1, "mesh", "two_sided", &two_sided);
+    clua_shape *s = new_shape(L); /* owns the arrays from here (collected on error) */
+    int nv = read_groups(L, "mesh", "vertices", 2, 3, &s->points);
+    double *tv;
+    int nt = read_groups(L, "mesh", "triangles", 3, 3, &tv);
+    if (nv < 3) clua_arg_error(L, 1, "mesh", "vertices: need at least 3, got %d", nv);
+    if (nt < 1) { free(tv); clua_arg_error(L, 1, "mesh", "triangles: need at least 1"); }
+    for (int i = 0; i < 3 * nv; i++)
+        if (!isfinite(s->points[i]) || fabs(s->points[i]) > RANGE_LENGTH_MAX) {
+            free(tv);
+            clua_arg_error(L, 1, "mesh", "vertices[%d] is not finite (or beyond 1e6 m)", i / 3 + 1);
+        }
+    s->indices = to_indices(L, "mesh", "triangles", tv, 3 * nt, nv, 3);
+    s->def = carom_shape_sphere(1);
+    s->def.type = CAROM_SHAPE_MESH;
+    s->mesh = carom_mesh_def_default();
+    s->mesh.vertices = s->points; s->mesh.vertex_count = nv;
+    s->mesh.triangles = s->indices; s->mesh.triangle_count = nt;
+    s->mesh.two_sided = two_sided;
+    /* the world checks the rest (repeated indices, zero area) when the body is made */
+    return 1;
+}
+
+/* carom.heightfield{heights = {...}, rows = R, columns = C, cell = {dx, dy}, holes = {...}}:
+ * heights row by row, row 1 at the lowest y; holes are 1-based cell indices. */
+static int l_heightfield(lua_State *L)
+{
+    static const char *const keys[] = {"heights", "rows", "columns", "cell", "holes", NULL};
+    check_shape_args(L, "heightfield", keys);
+    normalise_positions(L, "heightfield", keys);
+    double rows = 0, columns = 0;
+    if (!clua_field_number(L, 1, "heightfield", "rows", &rows) || !(rows >= 2 && rows == floor(rows) && rows <= 1e8))
+        clua_arg_error(L, 1, "heightfield", "rows must be an integer >= 2");
+    if (!clua_field_number(L, 1, "heightfield", "columns", &columns) || !(columns >= 2 && columns == floor(columns) && columns <= 1e8))
+        clua_arg_error(L, 1, "heightfield", "columns must be an integer >= 2");
+    if (rows * columns > 1e8) clua_arg_error(L, 1, "heightfield", "rows x columns must be at most 1e8");
+    double dx = 1, dy = 1;
+    int ct = clua_rawfield(L, 1, "cell");
+    if (ct == LUA_TNUMBER) dx = dy = lua_tonumber(L, -1);
+    else if (ct == LUA_TTABLE) {
+        if (lua_rawgeti(L, -1, 1) != LUA_TNUMBER || lua_rawgeti(L, -2, 2) != LUA_TNUMBER)
+            clua_arg_error(L, 1, "heightfield", "cell must be {dx, dy} or a number");
+        dx = lua_tonumber(L, -2); dy = lua_tonumber(L, -1);
+        lua_pop(L, 2);
+    } else if (ct != LUA_TNIL) clua_arg_error(L, 1, "heightfield", "cell must be {dx, dy} or a number");
+    lua_pop(L, 1);
+    if (!(dx >= RANGE_LENGTH_MIN && dx <= RANGE_LENGTH_MAX && dy >= RANGE_LENGTH_MIN && dy <= RANGE_LENGTH_MAX))
+        clua_arg_error(L, 1, "heightfield", "cell sizes must be in [1e-6, 1e6] m");
+    if (clua_rawfield(L, 1, "heights") != LUA_TTABLE) clua_arg_error(L, 1, "heightfield", "heights must be a list of numbers");
+    int ht = lua_gettop(L);
+    int has_holes = clua_rawfield(L, 1, "holes") != LUA_TNIL;
+    if (has_holes && lua_type(L, -1) != LUA_TTABLE) clua_arg_error(L, 1, "heightfield", "holes must be a list of cell indices");
+    int hl = lua_gettop(L);
+    clua_shape *s = new_shape(L);
+    int n = read_groups(L, "heightfield", "heights", ht, 1, &s->points);
+    if (n != (int)(rows * columns))
+        clua_arg_error(L, 1, "heightfield", "heights: need rows x columns = %d numbers, got %d", (int)(rows * columns), n);
+    for (int i = 0; i < n; i++)
+        if (!isfinite(s->points[i]) || fabs(s->points[i]) > RANGE_LENGTH_MAX)
+            clua_arg_error(L, 1, "heightfield", "heights[%d] is not finite (or beyond 1e6 m)", i + 1);
+    int nh = 0;
+    if (has_holes) {
+        double *hv;
+        nh = read_groups(L, "heightfield", "holes", hl, 1, &hv);
+        s->indices = to_indices(L, "heightfield", "holes", hv, nh, (int)((rows - 1) * (columns - 1)), 1);
+    }
+    s->def = carom_shape_sphere(1);
+    s->def.type = CAROM_SHAPE_HEIGHTFIELD;
+    s->heightfield = carom_heightfield_def_default();
+    s->heightfield.heights = s->points;
+    s->heightfield.rows = (int)rows; s->heightfield.columns = (int)columns;
+    s->heightfield.cell_x = dx; s->heightfield.cell_y = dy;
+    s->heightfield.holes = s->indices; s->heightfield.hole_count = nh;
+    return 1;
+}
+
 /* ---- metamethods ----------------------------------------------------------- */
 
 static int shape_gc(lua_State *L)
 {
     clua_shape *s = luaL_checkudata(L, 1, CLUA_SHAPE_MT);
     free(s->points);
+    free(s->indices);
     s->points = NULL;
+    s->indices = NULL;
     s->def.points = NULL;
     s->def.point_count = 0;
     return 0;
@@ -200,6 +355,17 @@ static int shape_tostring(lua_State *L)
     case CAROM_SHAPE_CAPSULE: snprintf(buf, sizeof buf, "carom.capsule{radius = %g, half_height = %g}", d->radius, d->half_height); break;
     case CAROM_SHAPE_CYLINDER: snprintf(buf, sizeof buf, "carom.cylinder{radius = %g, half_height = %g}", d->radius, d->half_height); break;
     case CAROM_SHAPE_HULL: snprintf(buf, sizeof buf, "carom.hull{%d points}", d->point_count); break;
+    case CAROM_SHAPE_MESH: {
+        const clua_shape *s = lua_touserdata(L, 1);
+        snprintf(buf, sizeof buf, "carom.mesh{%d vertices, %d triangles}", s->mesh.vertex_count, s->mesh.triangle_count);
+        break;
+    }
+    case CAROM_SHAPE_HEIGHTFIELD: {
+        const clua_shape *s = lua_touserdata(L, 1);
+        snprintf(buf, sizeof buf, "carom.heightfield{%d x %d, cell = {%g, %g}}", s->heightfield.rows,
+                 s->heightfield.columns, s->heightfield.cell_x, s->heightfield.cell_y);
+        break;
+    }
     default:
         snprintf(buf, sizeof buf, "carom.plane{normal = {%g, %g, %g}, offset = %g}", d->normal.x, d->normal.y, d->normal.z, d->offset);
         break;
@@ -226,6 +392,8 @@ static int shape_eq(lua_State *L)
             same = p->point_count == q->point_count &&
                    (p->point_count == 0 || memcmp(p->points, q->points, sizeof(double) * 3 * (size_t)p->point_count) == 0);
             break;
+        case CAROM_SHAPE_MESH:
+        case CAROM_SHAPE_HEIGHTFIELD: same = a == b; break; /* level geometry: the same descriptor */
         default: same = vec_eq(p->normal, q->normal) && p->offset == q->offset; break;
         }
     }
@@ -264,7 +432,7 @@ void clua_open_shapes(lua_State *L)
                                     {"__index", shape_index}, {"__newindex", shape_newindex}, {NULL, NULL}};
     static const luaL_Reg constructors[] = {{"sphere", l_sphere}, {"box", l_box}, {"capsule", l_capsule},
                                             {"cylinder", l_cylinder}, {"hull", l_hull}, {"plane", l_plane},
-                                            {NULL, NULL}};
+                                            {"mesh", l_mesh}, {"heightfield", l_heightfield}, {NULL, NULL}};
     luaL_newmetatable(L, CLUA_SHAPE_MT);
     luaL_setfuncs(L, meta, 0);
     lua_pushliteral(L, "locked");

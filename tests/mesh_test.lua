@@ -1,0 +1,127 @@
+-- mesh_test.lua - carom.mesh and carom.heightfield from Lua: a ball rolls on
+-- each as on a plane (the same path, computed in the same run), ray casts hit
+-- them where the geometry says, and every bad input is refused naming the
+-- field. Run by `make check` as `carom-run --test tests/mesh_test.lua`.
+local carom = require "carom"
+local passed, failed = 0, 0
+
+local function test(name, fn)
+  local ok, err = xpcall(fn, debug.traceback)
+  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
+end
+
+local function raises(text, fn, ...)
+  local ok, err = pcall(fn, ...)
+  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
+  if not tostring(err):find(text, 1, true) then
+    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
+  end
+end
+
+-- an n x n grid of 1 m cells centred on the origin at z = 0
+local function grid(n)
+  local vertices, triangles = {}, {}
+  for j = 0, n do
+    for i = 0, n do vertices[#vertices + 1] = {i - n / 2, j - n / 2, 0} end
+  end
+  for j = 0, n - 1 do
+    for i = 0, n - 1 do
+      local a = j * (n + 1) + i + 1
+      local b, c, d = a + 1, a + n + 2, a + n + 1
+      triangles[#triangles + 1] = {a, b, c}
+      triangles[#triangles + 1] = {a, c, d}
+    end
+  end
+  return vertices, triangles
+end
+
+-- the ball's path on a floor shape, 3 s at 60 Hz
+local function roll(floor)
+  local world = carom.world{}
+  world:add_body{ type = "static", shape = floor }
+  local ball = world:add_body{ shape = carom.sphere{ radius = 0.3 }, position = {-2, -1.5, 0.3},
+                               velocity = {0.8, 0.5, 0}, angular_velocity = {-0.5 / 0.3, 0.8 / 0.3, 0} }
+  local path = {}
+  for i = 1, 180 do
+    world:step(1 / 60)
+    path[i] = {ball:position()}
+  end
+  return path
+end
+
+local function largest_gap(p, q)
+  local gap = 0
+  for i = 1, #p do
+    local dx, dy, dz = p[i][1] - q[i][1], p[i][2] - q[i][2], p[i][3] - q[i][3]
+    gap = math.max(gap, math.sqrt(dx * dx + dy * dy + dz * dz))
+  end
+  return gap
+end
+
+test("a ball rolls on a mesh and on a height field as on a plane", function()
+  local plane = roll(carom.plane{})
+  local v, t = grid(10)
+  local on_mesh = roll(carom.mesh{ vertices = v, triangles = t })
+  local heights = {}
+  for i = 1, 11 * 11 do heights[i] = 0 end
+  local on_field = roll(carom.heightfield{ heights = heights, rows = 11, columns = 11, cell = {1, 1} })
+  assert(largest_gap(plane, on_mesh) < 1e-3, "mesh path off the plane's by " .. largest_gap(plane, on_mesh))
+  assert(largest_gap(plane, on_field) < 1e-3, "height field path off the plane's by " .. largest_gap(plane, on_field))
+  -- it did move: about 0.94 m/s for 3 s
+  assert(math.abs(on_mesh[180][1] - plane[1][1]) > 1.5)
+end)
+
+test("flat number lists, two-sided meshes, descriptors", function()
+  local m = carom.mesh{ vertices = {0, 0, 0, 1, 0, 0, 0, 1, 0}, triangles = {1, 2, 3}, two_sided = true }
+  assert(m.type == "mesh")
+  assert(tostring(m) == "carom.mesh{3 vertices, 1 triangles}", tostring(m))
+  assert(m == m)
+  local h = carom.heightfield{ heights = {0, 0, 0, 0}, rows = 2, columns = 2, cell = 2, holes = {} }
+  assert(h.type == "heightfield")
+  local world = carom.world{}
+  local b = world:add_body{ type = "static", shape = m }
+  assert(b:shape_type() == "mesh")
+  -- two-sided: a ray from below hits it
+  local hit = world:ray_cast({0.2, 0.2, -1}, {0, 0, 2})
+  assert(hit == b, "two-sided mesh hit from below")
+end)
+
+test("ray casts hit a height field where its heights are, and miss its holes", function()
+  -- 3 x 3 points, 1 m cells: heights rise along x; cell 1 (lower left) is a hole
+  local world = carom.world{}
+  local field = world:add_body{ type = "static", shape = carom.heightfield{
+    heights = {0, 0.5, 1,  0, 0.5, 1,  0, 0.5, 1}, rows = 3, columns = 3, cell = {1, 1}, holes = {1} } }
+  -- over cell 2 (x in [0, 1]): height 0.5 + 0.5 x
+  local hit, point, normal = world:ray_cast({0.5, -0.5, 5}, {0, 0, -10})
+  assert(hit == field)
+  assert(math.abs(point[3] - 0.75) < 1e-12, "height " .. tostring(point[3]))
+  -- the slope's normal: (-0.5, 0, 1) / |.|
+  assert(math.abs(normal[1] + 0.5 / math.sqrt(1.25)) < 1e-12 and math.abs(normal[3] - 1 / math.sqrt(1.25)) < 1e-12)
+  assert(world:ray_cast({-0.5, -0.5, 5}, {0, 0, -10}) == nil, "a hole has no ground")
+end)
+
+test("bad input is refused naming the field", function()
+  raises("vertices[2] is not finite", carom.mesh, { vertices = {{0, 0, 0}, {0 / 0, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
+  raises("vertices[2] is not finite", carom.mesh, { vertices = {{0, 0, 0}, {math.huge, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
+  raises("triangles[1]: index 4", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 4}} })
+  raises("triangles[1]: index 0", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{0, 1, 2}} })
+  raises("triangles: need at least 1", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {} })
+  raises("vertices[1] is not a list of 3 numbers", carom.mesh, { vertices = {{0, 0}}, triangles = {{1, 2, 3}} })
+  raises("unknown option", carom.mesh, { vertices = {}, triangles = {}, colour = 1 })
+  local world = carom.world{}
+  local repeated = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 2}} }
+  raises("repeats", world.add_body, world, { type = "static", shape = repeated })
+  local flat = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, triangles = {{1, 2, 3}} }
+  raises("zero area", world.add_body, world, { type = "static", shape = flat })
+  local ok = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} }
+  raises("static or kinematic", world.add_body, world, { shape = ok })
+  raises("heights[2] is not finite", carom.heightfield, { heights = {0, 0 / 0, 0, 0}, rows = 2, columns = 2 })
+  raises("heights: need rows x columns = 4", carom.heightfield, { heights = {0, 0, 0}, rows = 2, columns = 2 })
+  raises("rows must be an integer", carom.heightfield, { heights = {0, 0}, rows = 1, columns = 2 })
+  raises("holes[1]: 2 is not an integer in 1..1", carom.heightfield, { heights = {0, 0, 0, 0}, rows = 2, columns = 2, holes = {2} })
+  raises("cell sizes", carom.heightfield, { heights = {0, 0, 0, 0}, rows = 2, columns = 2, cell = {0, 1} })
+  assert(world:body_count() == 0, "the world is unchanged")
+end)
+
+print(string.format("%d passed, %d failed", passed, failed))
+if failed > 0 then os.exit(1) end
