@@ -7,6 +7,7 @@
 #include <string.h>
 #include "array.h"
 #include "solver.h"
+#include "rotation.h"
 
 #define TWO_PI 6.283185307179586
 
@@ -314,7 +315,7 @@ int world_solve(carom_world *w, double dt)
         /* clamp before integrating: a finite but huge velocity set by the user
          * would otherwise overflow the pose to inf/NaN within the step */
         bodies[k].v = clamp_length(bs->velocity[i], def->max_linear_speed, &clamped);
-        bodies[k].w = clamp_length(bs->angular_velocity[i], def->max_angular_speed, &clamped);
+        bodies[k].w = clamp_length(bs->angular_velocity[i], dmax(def->max_angular_speed, 0.25 * TWO_PI / h), &clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
         s->delta_position[k] = v3_zero();
@@ -502,8 +503,18 @@ int world_solve(carom_world *w, double dt)
             bs->center[slot] = v3_add(bs->center[slot], dx);
             s->delta_position[b] = v3_add(s->delta_position[b], dx);
             if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
-                bs->rotation[slot] = q_integrate(bs->rotation[slot], B->w, h);
-                s->delta_rotation[b] = v3_madd(s->delta_rotation[b], h, B->w);
+                vec3 wr = B->w;
+                if (B->inv_mass > 0.0 && !(bs->flags[slot] & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION))) {
+                    /* between impulses L = I w is what holds: rotate with the
+                     * midpoint w of Euler's equations (rotation.c), the solver
+                     * keeps w = I_start^-1 L for the step's impulses */
+                    vec3 L = m3_mulv(m3_inverse(B->inv_inertia), B->w);
+                    bs->rotation[slot] = rotation_free_step(bs->rotation[slot], bs->inertia_local[slot],
+                                                            bs->inv_inertia_local[slot], L, h, &wr);
+                } else {
+                    bs->rotation[slot] = q_integrate(bs->rotation[slot], wr, h);
+                }
+                s->delta_rotation[b] = v3_madd(s->delta_rotation[b], h, wr);
             }
         }
         if (!penalty) {
@@ -575,12 +586,14 @@ int world_solve(carom_world *w, double dt)
 
     /* write velocities back; clamp and guard */
     int awake = 0;
-    double vmax = def->max_linear_speed, wmax = def->max_angular_speed;
+    /* the angular clamp never touches a body turning less than a quarter turn per sub-step */
+    double vmax = def->max_linear_speed, wmax = dmax(def->max_angular_speed, 0.25 * TWO_PI / h);
     for (int b = 1; b < nb; b++) {
         int slot = s->body_slot[b];
         vec3 v = bodies[b].v, av = bodies[b].w;
         v = clamp_length(v, vmax, &clamped);
-        av = clamp_length(av, wmax, &clamped);
+        int angular_clamped = 0;
+        av = clamp_length(av, wmax, &angular_clamped);
         quat q = bs->rotation[slot];
         if (!v3_is_finite(v) || !v3_is_finite(av) || !v3_is_finite(bs->center[slot]) ||
             !(isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z))) {
@@ -612,6 +625,8 @@ int world_solve(carom_world *w, double dt)
             body_update_inertia(bs, slot);
             av = m3_mulv(bs->inv_inertia_world[slot], L);
             if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));
+            /* at the new inertia a clamped spin can read faster again */
+            if (angular_clamped) av = clamp_length(av, wmax, &angular_clamped);
             if (!v3_is_finite(av)) { /* the ranges keep this finite; never let NaN through if not */
                 av = v3_zero();
                 w->stats.non_finite++;
@@ -620,6 +635,7 @@ int world_solve(carom_world *w, double dt)
         } else {
             body_update_inertia(bs, slot);
         }
+        clamped += angular_clamped > 0;
         awake++;
     }
     w->stats.clamped += clamped;

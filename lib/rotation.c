@@ -1,0 +1,100 @@
+/* rotation.c - orientation update of a rigid body between impulses.
+ *
+ * Between impulses a body's world angular momentum L is constant, but its
+ * angular velocity w = I(q)^-1 L is not: the body axes turn, and with them
+ * w (Euler's equations, I dw/dt = (I w) x w in the body frame). Rotating
+ * about a frozen w and then re-deriving w from L (what the step did first)
+ * keeps L but moves the body-frame momentum off its energy ellipsoid by
+ * ~ (w h)^2 every step, which spins bodies up and tips a major-axis spin onto
+ * the minor axis. Measured side by side (build/bench/rotation_methods, the
+ * box 0.5 x 0.25 x 0.1 m at 10 rad/s, h = 1/240 s, 20 s; relative energy
+ * drift, worst spin axis):
+ *   carry L          L exact, energy +330 % (major-axis spin ends on the minor)
+ *   implicit gyro    energy -30 %, L off by 16 % (about the intermediate axis)
+ *   splitting (DLM)  L exact, energy bounded, 5e-8 (2e-6 at h = 1/60)
+ *   midpoint         L exact, energy 3e-13 (round-off) at either step
+ * The midpoint rule keeps both quadratic invariants of Euler's equations
+ * (|L|^2 and L.I^-1 L) exactly, and its body-frame update is a Cayley
+ * rotation, which is exactly the normalised first-order quaternion update
+ * q + h/2 (0, w) q the step already uses: only the w it rotates with
+ * changes (the midpoint one instead of the start one). Its cost is a 3x3
+ * Newton solve, skipped for bodies with isotropic inertia. */
+#include <stddef.h>
+#include "rotation.h"
+
+static mat3 m3_sub(mat3 a, mat3 b) { return m3_add(a, m3_scale(b, -1.0)); }
+static mat3 skew(vec3 a) { return m3_cols(v3(0, a.z, -a.y), v3(-a.z, 0, a.x), v3(a.y, -a.x, 0)); }
+
+/* Solves y = y0 + (h/2) y x (Iinv y) for the body-frame midpoint momentum y. */
+static vec3 midpoint_momentum(vec3 y0, mat3 inv_inertia, double h)
+{
+    vec3 y = y0;
+    double scale = v3_len(y0);
+    for (int it = 0; it < 16; it++) {
+        vec3 u = m3_mulv(inv_inertia, y);
+        vec3 f = v3_sub(v3_sub(y, y0), v3_scale(v3_cross(y, u), 0.5 * h));
+        if (v3_len(f) <= 1e-15 * scale) break;
+        /* dF/dy = Id - h/2 ([y]x Iinv - [u]x) */
+        mat3 j = m3_add(m3_identity(), m3_scale(m3_sub(m3_mul(skew(y), inv_inertia), skew(u)), -0.5 * h));
+        y = v3_sub(y, m3_mulv(m3_inverse(j), f));
+    }
+    return y;
+}
+
+quat rotation_free_step(quat q, mat3 inertia_local, mat3 inv_inertia_local, vec3 L, double h, vec3 *omega_mid)
+{
+    (void)inertia_local;
+    vec3 y0 = q_inv_rotate(q, L);
+    vec3 y = midpoint_momentum(y0, inv_inertia_local, h);
+    vec3 w = q_rotate(q, m3_mulv(inv_inertia_local, y));
+    if (omega_mid) *omega_mid = w;
+    return q_integrate(q, w, h);
+}
+
+/* ---- the alternatives, for the side-by-side measurement ------------------- */
+
+static mat3 world_tensor(quat q, vec3 diag) { return m3_rotate_tensor(m3_from_quat(q), m3_diag(diag)); }
+
+void rotation_step_method(rotation_method m, quat *q, vec3 *w, vec3 inertia, double h)
+{
+    vec3 inv = v3(1.0 / inertia.x, 1.0 / inertia.y, 1.0 / inertia.z);
+    vec3 L = m3_mulv(world_tensor(*q, inertia), *w);
+    switch (m) {
+    case ROTATION_CARRY_L:
+        *q = q_integrate(*q, *w, h);
+        *w = m3_mulv(world_tensor(*q, inv), L);
+        return;
+    case ROTATION_IMPLICIT_GYRO: {
+        /* body frame, one Newton step on f(w1) = I (w1 - w0) + h w1 x I w1 */
+        vec3 wb = q_inv_rotate(*q, *w);
+        mat3 I = m3_diag(inertia);
+        vec3 f = v3_scale(v3_cross(wb, m3_mulv(I, wb)), h);
+        mat3 j = m3_add(I, m3_scale(m3_sub(m3_mul(skew(wb), I), skew(m3_mulv(I, wb))), h));
+        wb = v3_sub(wb, m3_mulv(m3_inverse(j), f));
+        *w = q_rotate(*q, wb);
+        *q = q_integrate(*q, *w, h);
+        return;
+    }
+    case ROTATION_SPLITTING: {
+        /* exact flows of L_i^2 / 2 I_i: rotation about body axis i by L_i h / I_i */
+        static const int order[5] = {0, 1, 2, 1, 0};
+        static const double frac[5] = {0.5, 0.5, 1.0, 0.5, 0.5};
+        for (int k = 0; k < 5; k++) {
+            int i = order[k];
+            vec3 axis = v3(i == 0, i == 1, i == 2);
+            vec3 lb = q_inv_rotate(*q, L);
+            double angle = v3_get(lb, i) * v3_get(inv, i) * h * frac[k];
+            *q = q_normalize(q_mul(*q, q_axis_angle(axis, angle)));
+        }
+        *w = m3_mulv(world_tensor(*q, inv), L);
+        return;
+    }
+    case ROTATION_MIDPOINT: {
+        vec3 wm;
+        mat3 I = m3_diag(inertia), Ii = m3_diag(inv);
+        *q = rotation_free_step(*q, I, Ii, L, h, &wm);
+        *w = m3_mulv(world_tensor(*q, inv), L);
+        return;
+    }
+    }
+}

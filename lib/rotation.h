@@ -1,0 +1,34 @@
+/* rotation.h - orientation update of a rigid body between impulses. */
+#ifndef CAROM_ROTATION_H
+#define CAROM_ROTATION_H
+
+#include "vecmath.h"
+
+/* Advances orientation q by h for a body whose world-frame angular momentum L
+ * is constant over h (no torque in between). inertia_local and
+ * inv_inertia_local are the body-frame tensors. Implicit midpoint (Cayley) on
+ * Euler's equations: world L is kept exactly and kinetic energy
+ * L.I^-1 L / 2 to the solve's round-off at any step size. Writes the world
+ * angular velocity the rotation used (the midpoint one) to *omega_mid when
+ * not NULL. */
+quat rotation_free_step(quat q, mat3 inertia_local, mat3 inv_inertia_local, vec3 L, double h, vec3 *omega_mid);
+
+/* The alternatives measured beside it (bench/rotation_methods.c):
+ * ROTATION_CARRY_L: rotate about the current world w, then w = I_new^-1 L
+ *   (what the step did before: L exact, energy grows ~ (w h)^2 per step);
+ * ROTATION_IMPLICIT_GYRO: one Newton step of implicit Euler on the gyroscopic
+ *   term, I (w1 - w0) + h w1 x I w1 = 0, then rotate with w1 (Box3D, Bullet:
+ *   stable, but it drains energy and does not keep L);
+ * ROTATION_SPLITTING: symplectic splitting of the free rigid body into exact
+ *   rotations about the body axes (Dullweber, Leimkuhler, McLachlan 1997),
+ *   Strang order x y z y x: L exact, energy error bounded O(h^2);
+ * ROTATION_MIDPOINT: rotation_free_step. */
+typedef enum rotation_method {
+    ROTATION_CARRY_L, ROTATION_IMPLICIT_GYRO, ROTATION_SPLITTING, ROTATION_MIDPOINT
+} rotation_method;
+
+/* One step of the chosen method on a free body with body-frame inertia
+ * diag(inertia) (principal axes): updates *q and the world angular velocity *w. */
+void rotation_step_method(rotation_method m, quat *q, vec3 *w, vec3 inertia, double h);
+
+#endif
