@@ -8,6 +8,7 @@
 #include "array.h"
 #include "solver.h"
 #include "rotation.h"
+#include "impact.h"
 
 #define TWO_PI 6.283185307179586
 
@@ -56,6 +57,7 @@ void solve_constraint(contact_constraint *c, const solve_context *sc, int use_bi
         double lambda = -p->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
         double total = p->normal_impulse + lambda;
         if (total < 0.0) total = 0.0;
+        if (sc->hold_bounces && s > 0.0 && c->restitution > 0.0 && total > p->normal_impulse) total = p->normal_impulse;
         lambda = total - p->normal_impulse;
         p->normal_impulse = total;
         p->total_normal_impulse += lambda;
@@ -119,6 +121,7 @@ static void solve_constraint_shock(contact_constraint *c, const solve_context *s
         double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, rb_n) - v3_dot(A->w, ra_n);
         /* the pass may pull back at most what the regular solve pushed */
         double lambda = dmax(-(vn + bias) / k, -p->normal_impulse);
+        if (sc->hold_bounces && s > 0.0 && c->restitution > 0.0 && lambda > 0.0) lambda = 0.0;
         p->shock_normal = lambda;
         p->total_normal_impulse += lambda;
         A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
@@ -168,37 +171,6 @@ static void warm_start(contact_constraint *cc, int n, impulse_body *bodies)
     for (int k = 0; k < n; k++) warm_start_constraint(&cc[k], bodies);
 }
 
-static void apply_restitution(contact_constraint *cc, const int *bouncing, int n, impulse_body *bodies, double threshold,
-                              int friction)
-{
-    for (int k = 0; k < n; k++) {
-        contact_constraint *c = &cc[bouncing[k]];
-        impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
-        for (int i = 0; i < c->count; i++) {
-            constraint_point *p = &c->p[i];
-            if (p->relative_velocity > -threshold || p->max_normal_impulse == 0.0) continue;
-            double vn = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
-            double lambda = -p->normal_mass * (vn + c->restitution * p->relative_velocity);
-            double total = dmax(p->normal_impulse + lambda, 0.0);
-            lambda = total - p->normal_impulse;
-            p->normal_impulse = total;
-            p->total_normal_impulse += lambda;
-            if (total > p->max_normal_impulse) p->max_normal_impulse = total;
-            impulse_apply(B, A, p->rb, p->ra, v3_scale(c->n, lambda));
-            if (!friction || c->friction <= 0.0) continue;
-            /* the rebound impulse raises the Coulomb bound too (the seed's mu J
-             * with J including restitution): friction may now stop more slip */
-            vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
-            double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-            double n1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1), n2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
-            coulomb_clamp(&n1, &n2, c->friction * p->normal_impulse);
-            p->tangent_impulse[0] = n1;
-            p->tangent_impulse[1] = n2;
-            impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2)));
-        }
-    }
-}
-
 /* Keeps plane-locked bodies in their plane: in-plane velocity, spin about the normal. */
 static void project_planar(carom_world *w, int nb)
 {
@@ -232,7 +204,6 @@ static vec3 clamp_length(vec3 v, double max, int *clamped)
  * instead of the whole stack. */
 #define WIDE_MIN_CONSTRAINTS 64
 #define SHOCK_MASS_RATIO 4.0
-#define RESTITUTION_PASSES 8
 
 /* Levels above the ground (static/kinematic = 0) by repeated relaxation over
  * the contact graph; bodies not resting on anything stay at INT_MAX / 2. */
@@ -329,14 +300,14 @@ int world_solve(carom_world *w, double dt)
     /* one block: constraints, then their points packed (most pairs of round
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
-                       sizeof(int) * (size_t)(3 * ncon + 2 * nb + 4);
+                       sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
     if (!array_reserve(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
     contact_constraint *cc = s->constraints;
     constraint_point *point_pool = (constraint_point *)(cc + ncon);
     int *order = (int *)(point_pool + npoints);
     int *level = order + ncon;
     int *count_buf = level + nb + 1;
-    int *bouncing = count_buf + nb + 3; /* manifolds restitution may act on */
+    int *in_contact = count_buf + nb + 3; /* per solver body: in some manifold this step */
 
     double contact_hertz = dmin(def->contact_hertz, 0.25 / h);
     softness soft = make_softness(contact_hertz, def->contact_damping_ratio, h);
@@ -376,11 +347,17 @@ int world_solve(carom_world *w, double dt)
         c->warm = cd->state;
         c->center_a = bs->center[sa];
         c->center_b = bs->center[sb];
-        double ga = bodies[c->a].inv_mass > 0.0 ? bs->gravity_scale[sa] : 0.0;
-        double gb = bodies[c->b].inv_mass > 0.0 ? bs->gravity_scale[sb] : 0.0;
-        c->gravity_closing = (gb - ga) * (c->n.x * def->gravity.x + c->n.y * def->gravity.y + c->n.z * def->gravity.z);
+        /* every force acting over the step, not only gravity: b's acceleration relative to a along n */
+        vec3 grav = v3(def->gravity.x, def->gravity.y, def->gravity.z);
+        vec3 acc_a = bodies[c->a].inv_mass > 0.0
+                         ? v3_madd(v3_scale(grav, bs->gravity_scale[sa]), bodies[c->a].inv_mass, bs->force[sa]) : v3_zero();
+        vec3 acc_b = bodies[c->b].inv_mass > 0.0
+                         ? v3_madd(v3_scale(grav, bs->gravity_scale[sb]), bodies[c->b].inv_mass, bs->force[sb]) : v3_zero();
+        c->gravity_closing = v3_dot(c->n, v3_sub(acc_b, acc_a));
         contacts_touching++;
     }
+    for (int b = 0; b < nb; b++) in_contact[b] = 0;
+    for (int k = 0; k < ncon; k++) in_contact[cc[k].a] = in_contact[cc[k].b] = 1;
     int shock = 0;
     if (def->shock_propagation && !penalty) {
         /* cheap test first: scenes without a heavy-on-light contact pay nothing */
@@ -460,9 +437,15 @@ int world_solve(carom_world *w, double dt)
         }
     }
 
+    /* impacts first, at the geometry of the moment of contact (impact.c) */
+    int impacts = !penalty && def->enable_restitution;
+    if (impacts && !impact_resolve(w, cc, ncon, nb, dt)) return 0;
+
     solve_context sc = {bodies, s->delta_position, s->delta_rotation, 1.0 / h,
                         def->contact_push_max_velocity, def->linear_slop, def->baumgarte,
-                        def->position_correction, friction_on};
+                        def->position_correction, friction_on, 0};
+    solve_context sc_last = sc;
+    sc_last.hold_bounces = impacts;
     vec3 g = v3(def->gravity.x, def->gravity.y, def->gravity.z);
 
     for (int step = 0; step < substeps; step++) {
@@ -500,6 +483,12 @@ int world_solve(carom_world *w, double dt)
             int slot = s->body_slot[b];
             impulse_body *B = &bodies[b];
             vec3 dx = v3_scale(B->v, h);
+            if (!in_contact[b] && B->inv_mass > 0.0 && !(bs->linear_damping[slot] > 0)) {
+                /* in free flight the acceleration is constant over the sub-step: x += v0 h + a h^2 / 2
+                 * exactly (v = v0 + a h here), where semi-implicit Euler's v h flies an arc low by v h / 2 */
+                vec3 acc = v3_madd(v3_scale(g, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
+                dx = v3_madd(dx, -0.5 * h * h, acc);
+            }
             bs->center[slot] = v3_add(bs->center[slot], dx);
             s->delta_position[b] = v3_add(s->delta_position[b], dx);
             if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
@@ -518,35 +507,22 @@ int world_solve(carom_world *w, double dt)
             }
         }
         if (!penalty) {
+            const solve_context *rc = step == substeps - 1 ? &sc_last : &sc;
             for (int it = 0; it < def->relax_iterations; it++) {
-                if (wide) wide_solve(wide, cc, &sc, 0);
-                else for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], &sc, 0);
+                if (wide) wide_solve(wide, cc, rc, 0);
+                else for (int c = 0; c < ncon; c++) solve_constraint(&cc[c], rc, 0);
             }
             if (def->relax_iterations > 0)
                 for (int o = 0; o < shock; o++) {
                     contact_constraint *c = &cc[order[o]];
                     if (c->wide_batch >= 0) wide_read_impulses(wide, c);
-                    solve_constraint_shock(c, &sc, 0, level[c->a] < level[c->b]);
+                    solve_constraint_shock(c, rc, 0, level[c->a] < level[c->b]);
                 }
             project_planar(w, nb);
         }
     }
     if (wide) wide_store(wide, cc);
-    if (!penalty && def->enable_restitution) {
-        /* several passes: simultaneous impacts (a ball meeting a wall and a ball
-         * at once) need the impulses to agree, which one Gauss-Seidel sweep does
-         * not give (elastic gas, 10 s: 4 passes keep 99.43 % of the energy, 8
-         * keep 99.90 %); only manifolds with restitution and an impact take part */
-        int nbounce = 0;
-        for (int c = 0; c < ncon; c++) {
-            if (cc[c].restitution == 0.0) continue;
-            for (int i = 0; i < cc[c].count; i++)
-                if (cc[c].p[i].relative_velocity <= -def->restitution_threshold) { bouncing[nbounce++] = c; break; }
-        }
-        for (int it = 0; it < RESTITUTION_PASSES && nbounce > 0; it++)
-            apply_restitution(cc, bouncing, nbounce, bodies, def->restitution_threshold, friction_on);
-        project_planar(w, nb);
-    }
+    if (impacts) impact_finish(w, nb);
 
     /* store impulses for warm starting, raise hit events */
     for (int c = 0; c < ncon; c++) {

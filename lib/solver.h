@@ -41,7 +41,7 @@ typedef struct contact_constraint {
     const manifold *m;
     const contact_point_state *warm; /* last step's impulses, matched by feature */
     vec3 center_a, center_b;     /* centres of mass */
-    double gravity_closing;      /* normal acceleration of b relative to a from gravity */
+    double gravity_closing;      /* normal acceleration of b relative to a from gravity and forces */
 } contact_constraint;
 
 softness make_softness(double hertz, double damping_ratio, double h);
@@ -54,6 +54,10 @@ typedef struct solve_context {
     double push_max, slop, baumgarte;
     carom_position_correction correction;
     int friction;
+    /* the step's last relax pass: speculative rows of manifolds with
+     * restitution add no impulse (they would stop an approach that meets its
+     * contact next step; the next step's impact phase meets it there) */
+    int hold_bounces;
 } solve_context;
 
 /* The scalar pass over one manifold (solver.c): normal rows, then friction;

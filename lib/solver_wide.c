@@ -48,6 +48,7 @@ typedef struct wide_point {
 typedef struct wide_batch {
     lane_t n[3], t1[3], t2[3];
     lane_t friction, bias_rate, mass_scale, impulse_scale;
+    lane_t restitution;
     int a[LANES], b[LANES];      /* solver bodies; an empty lane uses the static body 0 */
     int con[LANES];              /* constraint index per lane */
     int count;                   /* points per manifold, the same in every lane */
@@ -77,6 +78,7 @@ static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint 
         wb->t2[d][l] = v3_get(c->t2, d);
     }
     wb->friction[l] = c->friction;
+    wb->restitution[l] = c->restitution;
     wb->bias_rate[l] = c->soft.bias_rate;
     wb->mass_scale[l] = c->soft.mass_scale;
     wb->impulse_scale[l] = c->soft.impulse_scale;
@@ -313,6 +315,10 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
         lane_t old = p->normal_impulse;
         lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
         total = LANE_MAX(total, zero);
+        if (sc->hold_bounces) {
+            lane_mask hold = ahead & (wb->restitution > zero);
+            total = SELECT_LANES(hold, LANE_MIN(total, old), total);
+        }
         lane_t lambda = total - old;
         p->normal_impulse = total;
         p->total_normal_impulse += lambda;

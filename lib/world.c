@@ -186,7 +186,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     step_scratch *s = &w->scratch;
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
-    free(s->tight_box); free(s->pose); free(s->touching); free(s->wide);
+    free(s->tight_box); free(s->pose); free(s->touching); free(s->wide); free(s->impact);
     free(w);
 }
 

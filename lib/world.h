@@ -36,6 +36,9 @@ typedef struct step_scratch {
     int slot_capacity;
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;
+    void *impact;               /* impact.c's per-body states and pairs */
+    size_t impact_capacity;
+    int impact_bodies;          /* solver bodies impact_resolve recorded, 0: none */
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
 } step_scratch;
