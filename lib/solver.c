@@ -286,7 +286,7 @@ int world_solve(carom_world *w, double dt)
         /* clamp before integrating: a finite but huge velocity set by the user
          * would otherwise overflow the pose to inf/NaN within the step */
         bodies[k].v = clamp_length(bs->velocity[i], def->max_linear_speed, &clamped);
-        bodies[k].w = clamp_length(bs->angular_velocity[i], dmax(def->max_angular_speed, 0.25 * TWO_PI / h), &clamped);
+        bodies[k].w = clamp_length(bs->angular_velocity[i], def->max_angular_speed, &clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
         s->delta_position[k] = v3_zero();
@@ -562,8 +562,7 @@ int world_solve(carom_world *w, double dt)
 
     /* write velocities back; clamp and guard */
     int awake = 0;
-    /* the angular clamp never touches a body turning less than a quarter turn per sub-step */
-    double vmax = def->max_linear_speed, wmax = dmax(def->max_angular_speed, 0.25 * TWO_PI / h);
+    double vmax = def->max_linear_speed, wmax = def->max_angular_speed;
     for (int b = 1; b < nb; b++) {
         int slot = s->body_slot[b];
         vec3 v = bodies[b].v, av = bodies[b].w;
