@@ -1,6 +1,7 @@
 /* body_api.c - the public body functions: validated create/destroy, getters
  * and setters. Every entry checks its input and leaves the world unchanged
  * on error. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
@@ -121,6 +122,8 @@ static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_typ
                 FAIL("body_create: hull point %d has coordinate %g; each must be finite with |c| <= 1e6 m", i / 3,
                      sd->points[i]);
         break;
+    case CAROM_SHAPE_COMPOUND: /* the children are checked with the body def */
+        break;
     case CAROM_SHAPE_MESH:
     case CAROM_SHAPE_HEIGHTFIELD: {
         const char *what = sd->type == CAROM_SHAPE_MESH ? "mesh" : "heightfield";
@@ -161,6 +164,54 @@ static int check_mass_props(const carom_world *w, const mass_props *mp, const ch
 /* |v| within the world's clamp (max_linear_speed / max_angular_speed). */
 static int speed_ok(carom_vec3 v, double max) { return finite_c(v) && len_c(v) <= max; }
 
+#define COMPOUND_MAX_CHILDREN 256
+
+/* Child i of a compound def (the array's stride is its first element's size). */
+static carom_compound_child child_def(const carom_body_def *d, int i)
+{
+    carom_compound_child c = carom_compound_child_default(carom_shape_sphere(0.5));
+    size_t stride = d->children[0].size;
+    const carom_compound_child *src = (const carom_compound_child *)(const void *)((const char *)d->children + stride * (size_t)i);
+    memcpy(&c, src, stride < sizeof c ? stride : sizeof c);
+    return c;
+}
+
+static int check_children(carom_world *w, const carom_body_def *d)
+{
+#define CFAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
+    if (!d->children || d->child_count < 1)
+        CFAIL("body_create: a compound needs children (got %d%s)", d->child_count, d->children ? "" : ", NULL array");
+    if (d->child_count > COMPOUND_MAX_CHILDREN)
+        CFAIL("body_create: a compound takes at most %d children (got %d)", COMPOUND_MAX_CHILDREN, d->child_count);
+    if (d->children[0].size < offsetof(carom_compound_child, density) + sizeof(double))
+        CFAIL("body_create: children[0].size %u too small: use carom_compound_child_default()", (unsigned)d->children[0].size);
+    for (int i = 0; i < d->child_count; i++) {
+        carom_compound_child c = child_def(d, i);
+        carom_shape_type t = c.shape.type;
+        if (t != CAROM_SHAPE_SPHERE && t != CAROM_SHAPE_BOX && t != CAROM_SHAPE_CAPSULE && t != CAROM_SHAPE_CYLINDER &&
+            t != CAROM_SHAPE_HULL)
+            CFAIL("body_create: children[%d].shape must be convex (sphere, box, capsule, cylinder or hull), got type %d", i, (int)t);
+        if (!check_shape(w, &c.shape, CAROM_BODY_DYNAMIC)) {
+            char msg[WORLD_ERROR_SIZE];
+            snprintf(msg, sizeof msg, "%s", carom_world_last_error(w));
+            const char *rest = strncmp(msg, "body_create: ", 13) == 0 ? msg + 13 : msg;
+            CFAIL("body_create: children[%d]: %s", i, rest);
+        }
+        if (!finite_c(c.position) || fabs(c.position.x) > RANGE_LENGTH_MAX || fabs(c.position.y) > RANGE_LENGTH_MAX ||
+            fabs(c.position.z) > RANGE_LENGTH_MAX)
+            CFAIL("body_create: children[%d].position must be finite (within 1e6 m)", i);
+        if (!quat_ok(c.orientation)) CFAIL("body_create: children[%d].orientation must be a finite unit quaternion", i);
+        if (!(isfinite(c.friction) && c.friction >= 0 && c.friction <= RANGE_FRICTION_MAX))
+            CFAIL("body_create: children[%d].friction must be in [0, 1e3]", i);
+        if (!(isfinite(c.restitution) && c.restitution >= 0 && c.restitution <= 1))
+            CFAIL("body_create: children[%d].restitution must be in [0, 1]", i);
+        if (!(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
+            CFAIL("body_create: children[%d].density must be in [1e-6, 1e9] kg/m^3", i);
+    }
+    return 1;
+#undef CFAIL
+}
+
 static int check_body_def(carom_world *w, const carom_body_def *d)
 {
 #define FAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
@@ -199,6 +250,7 @@ static int check_body_def(carom_world *w, const carom_body_def *d)
     if (d->lock_to_plane && !normal_ok(d->plane_normal))
         FAIL("body_create: plane_normal must be finite with length >= 1e-12");
 #undef FAIL
+    if (d->shape.type == CAROM_SHAPE_COMPOUND) return check_children(w, d);
     return check_shape(w, &d->shape, d->type);
 }
 
@@ -214,6 +266,65 @@ static void build_shape(const carom_shape_def *sd, shape *s)
         s->plane_normal = v3_scale(to_v3(sd->normal), 1.0 / len);
         s->plane_offset = sd->offset / len;
     }
+}
+
+/* The hull of a shape def into sh->hull; 0 with the error set (who: "" or "children[i]: "). */
+static int build_hull(carom_world *w, const carom_shape_def *sd, shape *sh, const char *who)
+{
+    char err[160];
+    sh->hull = hull_build(sd->points, sd->point_count, err, (int)sizeof err);
+    if (!sh->hull) {
+        world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %sbad hull: %s", who, err);
+        return 0;
+    }
+    int fv = 0;
+    for (int f = 0; f < sh->hull->face_count; f++) fv += sh->hull->faces[f].count;
+    if (sh->hull->vertex_count > HULL_MAX_VERTICES || sh->hull->face_count > HULL_MAX_FACES ||
+        fv > HULL_MAX_FACE_VERTICES || sh->hull->edge_count > HULL_MAX_FACE_VERTICES / 2) {
+        world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                   "body_create: %shull has %d vertices and %d faces; at most %d and %d (simplify the point set)", who,
+                   sh->hull->vertex_count, sh->hull->face_count, HULL_MAX_VERTICES, HULL_MAX_FACES);
+        hull_free(sh->hull);
+        sh->hull = NULL;
+        return 0;
+    }
+    return 1;
+}
+
+static int build_compound(carom_world *w, const carom_body_def *d, shape *sh)
+{
+    int n = d->child_count;
+    compound *c = calloc(1, sizeof *c);
+    if (c) {
+        c->children = calloc((size_t)n, sizeof *c->children);
+        c->poses = malloc(sizeof *c->poses * (size_t)n);
+        c->friction = malloc(sizeof *c->friction * (size_t)n);
+        c->restitution = malloc(sizeof *c->restitution * (size_t)n);
+        c->density = malloc(sizeof *c->density * (size_t)n);
+    }
+    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density) {
+        compound_free(c);
+        world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
+        return 0;
+    }
+    for (int i = 0; i < n; i++) {
+        carom_compound_child cd = child_def(d, i);
+        build_shape(&cd.shape, &c->children[i]);
+        c->count = i + 1; /* so a failure below frees what was built */
+        char who[32];
+        snprintf(who, sizeof who, "children[%d]: ", i);
+        if (cd.shape.type == CAROM_SHAPE_HULL && !build_hull(w, &cd.shape, &c->children[i], who)) {
+            compound_free(c);
+            return 0;
+        }
+        xform pose = {to_v3(cd.position), q_normalize((quat){cd.orientation.w, cd.orientation.x, cd.orientation.y, cd.orientation.z})};
+        c->poses[i] = pose;
+        c->friction[i] = cd.friction;
+        c->restitution[i] = cd.restitution;
+        c->density[i] = cd.density;
+    }
+    sh->compound = c;
+    return 1;
 }
 
 CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *user_def)
@@ -266,27 +377,19 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
             return null_id;
         }
     }
-    if (d.shape.type == CAROM_SHAPE_HULL) {
-        char err[160];
-        sh.hull = hull_build(d.shape.points, d.shape.point_count, err, (int)sizeof err);
-        if (!sh.hull) {
-            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: bad hull: %s", err);
-            return null_id;
-        }
-        int fv = 0;
-        for (int f = 0; f < sh.hull->face_count; f++) fv += sh.hull->faces[f].count;
-        if (sh.hull->vertex_count > HULL_MAX_VERTICES || sh.hull->face_count > HULL_MAX_FACES ||
-            fv > HULL_MAX_FACE_VERTICES || sh.hull->edge_count > HULL_MAX_FACE_VERTICES / 2) {
-            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                       "body_create: hull has %d vertices and %d faces; at most %d and %d (simplify the point set)",
-                       sh.hull->vertex_count, sh.hull->face_count, HULL_MAX_VERTICES, HULL_MAX_FACES);
-            hull_free(sh.hull);
-            return null_id;
-        }
-    }
+    if (d.shape.type == CAROM_SHAPE_HULL && !build_hull(w, &d.shape, &sh, "")) return null_id;
+    if (d.shape.type == CAROM_SHAPE_COMPOUND && !build_compound(w, &d, &sh)) return null_id;
     mass_props mp = {0, {0, 0, 0}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
-    if (sh.type != SHAPE_PLANE)
+    if (sh.type == SHAPE_COMPOUND) {
+        mp = compound_mass(sh.compound);
+        if (d.mass > 0 && mp.mass > 0) { /* the given mass rescales every child */
+            double k = d.mass / mp.mass;
+            mp.mass = d.mass;
+            mp.inertia = m3_scale(mp.inertia, k);
+        }
+    } else if (sh.type != SHAPE_PLANE) {
         mp = d.mass > 0 ? shape_mass_from_mass(&sh, d.mass) : shape_mass_from_density(&sh, d.density);
+    }
     if (d.type == CAROM_BODY_DYNAMIC && !check_mass_props(w, &mp, "body_create")) {
         shape_free_data(&sh);
         return null_id;
@@ -600,7 +703,7 @@ CAROM_API carom_status carom_body_set_type(carom_world *w, carom_body_id id, car
     if (s->type[slot] == (int)type) return CAROM_OK;
     if (s->shapes[slot].type == SHAPE_PLANE)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a plane must stay static");
-    if (type == CAROM_BODY_DYNAMIC && shape_is_composite(&s->shapes[slot]))
+    if (type == CAROM_BODY_DYNAMIC && (s->shapes[slot].type == SHAPE_MESH || s->shapes[slot].type == SHAPE_HEIGHTFIELD))
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a mesh or heightfield cannot be dynamic");
     if (type == CAROM_BODY_DYNAMIC) {
         mass_props mp = {s->mass[slot], s->local_center[slot], s->inertia_local[slot]};

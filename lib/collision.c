@@ -58,8 +58,10 @@ int world_update_pairs(carom_world *w)
     return 1;
 }
 
-static void push_touch_event(carom_world *w, const contact *c, const contact_data *d, carom_event_type type)
+static void push_touch_event(carom_world *w, int contact_index, carom_event_type type)
 {
+    const contact *c = &w->contacts.items[contact_index];
+    const contact_data *d = &w->contacts.data[contact_index];
     carom_contact_event e;
     memset(&e, 0, sizeof e);
     e.type = type;
@@ -70,7 +72,7 @@ static void push_touch_event(carom_world *w, const contact *c, const contact_dat
         vec3 p = d->m.points[0].point;
         e.point.x = p.x; e.point.y = p.y; e.point.z = p.z;
     }
-    world_push_event(w, &e);
+    if (world_push_event(w, &e)) world_set_last_event_contact(w, contact_index);
 }
 
 /* B's frame expressed in A's. */
@@ -151,66 +153,95 @@ static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa
     c->flags |= CONTACT_REUSABLE;
 }
 
-/* A pair with a mesh or height field: its manifolds (one per normal) go to
- * the pair's contact (sub 0) and its extra contacts (sub 1..), each manifold
- * to the contact whose last normal is nearest, so warm starting follows it.
- * near: the bounds are within the look-ahead (else every manifold empties).
- * Returns 1 when any manifold has points; 0 on out of memory too (the pair
- * then keeps only what fits). */
+/* A pair with a mesh, height field or compound: its manifolds go to the
+ * pair's contact (sub 0) and its extra contacts (sub 1..). A child pair owns
+ * the subs base .. base + 3 (see collide_multi); within them each manifold
+ * goes to the contact whose last normal is nearest, so warm starting follows
+ * it. near: the bounds are within the look-ahead (else every manifold
+ * empties). Returns 1 when any manifold has points. Out of memory drops the
+ * manifolds that found no contact. */
 static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, double spec, int near)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     int id_a = cs->items[ci].id_a, id_b = cs->items[ci].id_b;
     int a = s->ids[id_a].slot, b = s->ids[id_b].slot;
-    manifold found[COMPOSITE_MAX_MANIFOLDS];
-    int n = near ? collide_composite(&s->shapes[a], xa, &s->shapes[b], xb, spec, found, COMPOSITE_MAX_MANIFOLDS) : 0;
-    int slot_of[COMPOSITE_MAX_MANIFOLDS], taken[COMPOSITE_MAX_MANIFOLDS] = {0, 0, 0, 0};
-    int index[COMPOSITE_MAX_MANIFOLDS];
-    for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) index[k] = k == 0 ? ci : contact_find_sub(cs, id_a, id_b, (uint32_t)k);
-    for (int j = 0; j < n; j++) {
-        /* the contact that last had the nearest normal, else the first free one */
-        int best = -1;
-        double best_dot = 0.9;
-        for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
-            if (taken[k] || index[k] < 0 || cs->data[index[k]].m.count == 0) continue;
-            double d = v3_dot(cs->data[index[k]].m.normal, found[j].normal);
-            if (d > best_dot) { best_dot = d; best = k; }
+    const shape *sha = &s->shapes[a], *shb = &s->shapes[b];
+    manifold found[PAIR_MAX_MANIFOLDS];
+    uint32_t base[PAIR_MAX_MANIFOLDS], sub_of[PAIR_MAX_MANIFOLDS];
+    int n = near ? collide_multi(sha, xa, shb, xb, spec, found, base, PAIR_MAX_MANIFOLDS) : 0;
+    /* the subs of each child pair, by normal */
+    for (int j0 = 0; j0 < n;) {
+        int j1 = j0 + 1;
+        while (j1 < n && base[j1] == base[j0]) j1++;
+        int index[COMPOSITE_MAX_MANIFOLDS], taken[COMPOSITE_MAX_MANIFOLDS] = {0, 0, 0, 0};
+        for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++)
+            index[k] = base[j0] + (uint32_t)k == 0 ? ci : contact_find_sub(cs, id_a, id_b, base[j0] + (uint32_t)k);
+        for (int j = j0; j < j1; j++) {
+            int best = -1;
+            double best_dot = 0.9;
+            for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
+                if (taken[k] || index[k] < 0 || cs->data[index[k]].m.count == 0) continue;
+                double d = v3_dot(cs->data[index[k]].m.normal, found[j].normal);
+                if (d > best_dot) { best_dot = d; best = k; }
+            }
+            for (int k = 0; best < 0 && k < COMPOSITE_MAX_MANIFOLDS; k++)
+                if (!taken[k] && (index[k] < 0 || cs->data[index[k]].m.count == 0)) best = k;
+            if (best < 0) best = 0; /* cannot happen: at most COMPOSITE_MAX_MANIFOLDS per child pair */
+            taken[best] = 1;
+            sub_of[j] = base[j0] + (uint32_t)best;
         }
-        for (int k = 0; best < 0 && k < COMPOSITE_MAX_MANIFOLDS; k++)
-            if (!taken[k] && (index[k] < 0 || cs->data[index[k]].m.count == 0)) best = k;
-        taken[best] = 1;
-        slot_of[j] = best;
+        j0 = j1;
     }
     int any = 0;
-    for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
-        int j = -1;
-        for (int q = 0; q < n; q++) if (slot_of[q] == k) j = q;
-        if (index[k] < 0) {
-            if (j < 0) continue;
-            index[k] = contact_add_sub(cs, id_a, id_b, (uint32_t)k);
-            if (index[k] < 0) continue; /* out of memory: this manifold is dropped this step */
-            cs->data[index[k]].friction = cs->data[ci].friction;
-            cs->data[index[k]].restitution = cs->data[ci].restitution;
+    /* this step's manifolds into their contacts */
+    for (int j = 0; j < n; j++) {
+        uint32_t sub = sub_of[j];
+        int k = sub == 0 ? ci : contact_find_sub(cs, id_a, id_b, sub);
+        if (k < 0) {
+            k = contact_add_sub(cs, id_a, id_b, sub);
+            if (k < 0) continue;
+            if (sub + 1 > cs->items[ci].sub_limit) cs->items[ci].sub_limit = sub + 1;
         }
-        contact *c = &cs->items[index[k]];
-        contact_data *d = &cs->data[index[k]];
-        c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
-        if (j < 0) {
-            d->m.count = 0;
-        } else {
-            manifold old_m = d->m;
-            contact_point_state old_state[MANIFOLD_MAX_POINTS];
-            memcpy(old_state, d->state, sizeof old_state);
-            d->m = found[j];
-            contact_match_points(d, &old_m, old_state, xa);
-            any = 1;
-        }
+        contact *c = &cs->items[k];
+        contact_data *d = &cs->data[k];
+        compound_sub_material(sha, shb, sub, s->friction[a], s->friction[b], s->restitution[a], s->restitution[b],
+                              &d->friction, &d->restitution);
+        manifold old_m = d->m;
+        contact_point_state old_state[MANIFOLD_MAX_POINTS];
+        memcpy(old_state, d->state, sizeof old_state);
+        d->m = found[j];
+        contact_match_points(d, &old_m, old_state, xa);
+        any = 1;
         int was = (c->flags & CONTACT_TOUCHING) != 0;
-        c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
-                   (d->m.count > 0 ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
+        c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_REUSABLE | CONTACT_APART)) |
+                   CONTACT_TOUCHING | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
+    }
+    /* the pair's other contacts found nothing this step */
+    for (uint32_t sub = 0; sub < (cs->items[ci].sub_limit > 0 ? cs->items[ci].sub_limit : 1); sub++) {
+        int used = 0;
+        for (int j = 0; j < n && !used; j++) used = sub_of[j] == sub;
+        if (used) continue;
+        int k = sub == 0 ? ci : contact_find_sub(cs, id_a, id_b, sub);
+        if (k < 0) continue;
+        contact *c = &cs->items[k];
+        cs->data[k].m.count = 0;
+        int was = (c->flags & CONTACT_TOUCHING) != 0;
+        c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_REUSABLE | CONTACT_APART)) |
+                   (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
     }
     return any;
+}
+
+void world_set_last_event_contact(carom_world *w, int contact_index)
+{
+    event_buffer *e = &w->events;
+    if (e->count == 0) return;
+    const contact *c = &w->contacts.items[contact_index];
+    int a = w->bodies.ids[c->id_a].slot, b = w->bodies.ids[c->id_b].slot;
+    if (a < 0 || b < 0) return;
+    compound_sub_children(&w->bodies.shapes[a], &w->bodies.shapes[b], c->sub, &e->children[e->count - 1][0],
+                          &e->children[e->count - 1][1]);
 }
 
 /* Wakes a sleeping body during the collision stage; its later pairs read
@@ -256,7 +287,7 @@ int world_collide(carom_world *w)
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
-            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, c, d, CAROM_EVENT_END);
+            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, i, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
@@ -282,12 +313,12 @@ int world_collide(carom_world *w)
             }
             if (touching != was) {
                 /* the event speaks of the pair: any manifold with points */
-                const contact_data *ed = d;
-                for (uint32_t k = 1; ed->m.count == 0 && k < COMPOSITE_MAX_MANIFOLDS; k++) {
+                int ei = i;
+                for (uint32_t k = 1; cs->data[ei].m.count == 0 && k < c->sub_limit; k++) {
                     int e = contact_find_sub(cs, c->id_a, c->id_b, k);
-                    if (e >= 0 && cs->data[e].m.count > 0) ed = &cs->data[e];
+                    if (e >= 0 && cs->data[e].m.count > 0) ei = e;
                 }
-                push_touch_event(w, c, ed, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
+                push_touch_event(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
             }
             if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
             i++;
@@ -327,8 +358,8 @@ int world_collide(carom_world *w)
             if (!awake_a) wake_for_step(w, a);
             if (!awake_b) wake_for_step(w, b);
         }
-        if (touching && !was) push_touch_event(w, c, d, CAROM_EVENT_BEGIN);
-        else if (!touching && was) push_touch_event(w, c, d, CAROM_EVENT_END);
+        if (touching && !was) push_touch_event(w, i, CAROM_EVENT_BEGIN);
+        else if (!touching && was) push_touch_event(w, i, CAROM_EVENT_END);
         if (touching) sc->touching[sc->touching_count++] = i;
         i++;
     }

@@ -31,6 +31,7 @@ typedef struct contact {
     uint32_t flags;
     uint32_t sub;               /* 0: the broadphase pair's contact; k > 0: its k-th extra
                                    manifold (a mesh or height field gives one per normal) */
+    uint32_t sub_limit;         /* sub 0 of a composite pair: every extra contact's sub is below this */
     collide_cache cache;
     xform rel_pose;             /* B's frame in A's when the manifold was computed */
     double gap, reach_b;        /* apart: a lower bound on the distance then, and B's

@@ -813,8 +813,9 @@ int collide(const shape *a, xform xa, const shape *b, xform xb, double speculati
      * find no best face and index with -1) */
     if (!xform_is_finite(xa) || !xform_is_finite(xb)) return 0;
     if (shape_is_composite(a) || shape_is_composite(b)) {
-        manifold all[COMPOSITE_MAX_MANIFOLDS];
-        int n = collide_composite(a, xa, b, xb, speculative, all, COMPOSITE_MAX_MANIFOLDS);
+        manifold all[PAIR_MAX_MANIFOLDS];
+        uint32_t base[PAIR_MAX_MANIFOLDS];
+        int n = collide_multi(a, xa, b, xb, speculative, all, base, PAIR_MAX_MANIFOLDS);
         double deepest = 1e300;
         for (int k = 0; k < n; k++)
             for (int i = 0; i < all[k].count; i++)

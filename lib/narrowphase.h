@@ -54,6 +54,21 @@ int collide_composite(const shape *a, xform xa, const shape *b, xform xb, double
 int collide_triangle(const vec3 v[3], unsigned active, int two_sided, const shape *s, xform xs, double speculative,
                      manifold *m);
 
+/* Most manifolds one pair gets (compound children, each against a mesh in
+ * up to COMPOSITE_MAX_MANIFOLDS). */
+#define PAIR_MAX_MANIFOLDS 64
+/* Any pair with a mesh, height field or compound on either side: its
+ * manifolds (normal a to b) and for each the base of its contact numbers
+ * (a multiple of COMPOSITE_MAX_MANIFOLDS naming the child pair); returns how
+ * many. compound.c. */
+int collide_multi(const shape *a, xform xa, const shape *b, xform xb, double speculative, manifold *out,
+                  uint32_t *base, int max);
+/* The compound children a contact number `sub` of the pair belongs to (-1: not a compound). */
+void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *child_a, int *child_b);
+/* The mixed material of that contact: a compound child's own, else the body's. */
+void compound_sub_material(const shape *a, const shape *b, uint32_t sub, double body_friction_a, double body_friction_b,
+                           double body_restitution_a, double body_restitution_b, double *friction, double *restitution);
+
 /* Reduces up to n candidate points to at most 4 (deepest first, then the
  * largest area), in place; returns the new count. */
 int manifold_reduce(manifold_point *pts, int n, vec3 normal);

@@ -23,6 +23,11 @@ double shape_volume(const shape *s)
     case SHAPE_CAPSULE: return PI * r * r * h + 4.0 / 3.0 * PI * r * r * r;
     case SHAPE_CYLINDER: return PI * r * r * h;
     case SHAPE_HULL: return s->hull->volume;
+    case SHAPE_COMPOUND: {
+        double v = 0;
+        for (int i = 0; i < s->compound->count; i++) v += shape_volume(&s->compound->children[i]);
+        return v;
+    }
     default: return 0.0;
     }
 }
@@ -146,6 +151,7 @@ aabb shape_aabb(const shape *s, xform t)
         }
         return b;
     }
+    case SHAPE_COMPOUND: return compound_aabb(s->compound, t);
     case SHAPE_MESH: case SHAPE_HEIGHTFIELD: {
         /* the local bounds' corners, rotated */
         aabb lb = s->type == SHAPE_MESH ? mesh_bounds(s->mesh) : heightfield_bounds(s->field);
@@ -168,9 +174,11 @@ void shape_free_data(shape *s)
     hull_free(s->hull);
     mesh_free(s->mesh);
     heightfield_free(s->field);
+    compound_free(s->compound);
     s->hull = NULL;
     s->mesh = NULL;
     s->field = NULL;
+    s->compound = NULL;
 }
 
 vec3 shape_support_local(const shape *s, vec3 d)
@@ -206,6 +214,17 @@ vec3 shape_support_local(const shape *s, vec3 d)
         }
         return h->vertices[best];
     }
+    case SHAPE_COMPOUND: {
+        /* the children's farthest support point */
+        const compound *c = s->compound;
+        vec3 best = v3_zero();
+        double bd = -INFINITY;
+        for (int i = 0; i < c->count; i++) {
+            vec3 p = xf_point(c->poses[i], shape_support_local(&c->children[i], q_inv_rotate(c->poses[i].q, d)));
+            if (v3_dot(p, d) > bd) { bd = v3_dot(p, d); best = p; }
+        }
+        return best;
+    }
     default:
         return v3_zero();
     }
@@ -226,6 +245,12 @@ double shape_bounding_radius(const shape *s)
     case SHAPE_MESH: case SHAPE_HEIGHTFIELD: {
         aabb lb = s->type == SHAPE_MESH ? mesh_bounds(s->mesh) : heightfield_bounds(s->field);
         return v3_len(v3_max(v3_abs(lb.lo), v3_abs(lb.hi)));
+    }
+    case SHAPE_COMPOUND: {
+        double m = 0;
+        for (int i = 0; i < s->compound->count; i++)
+            m = dmax(m, v3_len(s->compound->poses[i].p) + shape_bounding_radius(&s->compound->children[i]));
+        return m;
     }
     default: return PLANE_EXTENT;
     }
@@ -1153,6 +1178,9 @@ int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t
         break;
     case SHAPE_HEIGHTFIELD:
         if (!heightfield_ray_cast(s->field, o, d, max_t, &tt, &n, NULL)) return 0;
+        break;
+    case SHAPE_COMPOUND:
+        if (!compound_ray_cast_local(s->compound, o, d, max_t, &tt, &n, NULL)) return 0;
         break;
     default:
         return 0;

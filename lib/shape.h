@@ -14,6 +14,7 @@ enum {
     SHAPE_PLANE,        /* static only: points x with dot(normal, x) = offset (body frame); solid below */
     SHAPE_MESH,         /* static or kinematic: triangles (mesh.h) */
     SHAPE_HEIGHTFIELD,  /* static or kinematic: a grid of heights (mesh.h) */
+    SHAPE_COMPOUND,     /* convex children, each with a pose and material (compound.c) */
     SHAPE_TYPE_COUNT
 };
 
@@ -48,10 +49,21 @@ typedef struct shape {
     double plane_offset;
     struct tri_mesh *mesh;        /* SHAPE_MESH: owned by the shape */
     struct height_field *field;   /* SHAPE_HEIGHTFIELD: owned by the shape */
+    struct compound *compound;    /* SHAPE_COMPOUND: owned by the shape */
 } shape;
 
-/* Meshes and height fields: many triangles, contacts in several manifolds. */
-static inline int shape_is_composite(const shape *s) { return s->type == SHAPE_MESH || s->type == SHAPE_HEIGHTFIELD; }
+typedef struct compound {
+    int count;
+    struct shape *children;  /* convex, each in its own frame */
+    xform *poses;            /* child frame in the body frame */
+    double *friction, *restitution, *density;
+} compound;
+
+/* Meshes, height fields and compounds: contacts in several manifolds. */
+static inline int shape_is_composite(const shape *s)
+{
+    return s->type == SHAPE_MESH || s->type == SHAPE_HEIGHTFIELD || s->type == SHAPE_COMPOUND;
+}
 /* Frees what the shape owns (hull, mesh, height field). */
 void shape_free_data(shape *s);
 
@@ -60,6 +72,13 @@ typedef struct mass_props {
     vec3 center;           /* centre of mass in the body frame */
     mat3 inertia;          /* about the centre of mass, body axes */
 } mass_props;
+
+/* compound.c */
+void compound_free(compound *c);
+/* Mass properties combined exactly (parallel axis); each child at its own density. */
+mass_props compound_mass(const compound *c);
+aabb compound_aabb(const compound *c, xform t);
+int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child);
 
 /* Volume of a shape (0 for a plane). */
 double shape_volume(const shape *s);

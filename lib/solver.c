@@ -556,7 +556,7 @@ int world_solve(carom_world *w, double dt)
             e.tangent_impulse = tangent;
             e.approach_speed = approach;
             e.average_force = impulse_average_force(total, dt);
-            world_push_event(w, &e);
+            if (world_push_event(w, &e)) world_set_last_event_contact(w, con->contact);
         }
     }
 

@@ -23,6 +23,12 @@ static double min_extent(const shape *s)
             m = dmin(m, s->hull->faces[i].offset - v3_dot(s->hull->faces[i].normal, s->hull->centroid));
         return m > 0 ? m : 0.0;
     }
+    case SHAPE_COMPOUND: {
+        /* the thinnest child can pass through first */
+        double m = 1e300;
+        for (int i = 0; i < s->compound->count; i++) m = dmin(m, min_extent(&s->compound->children[i]));
+        return m;
+    }
     default: return 1e300;
     }
 }

@@ -183,6 +183,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     if (w->bp) bp_destroy(w->bp);
     contact_set_free(&w->contacts);
     free(w->events.items);
+    free(w->events.children);
     step_scratch *s = &w->scratch;
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
@@ -222,8 +223,21 @@ int world_push_event(carom_world *w, const carom_contact_event *e)
 {
     event_buffer *b = &w->events;
     if (!array_reserve((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
+    if (!array_reserve((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
+    b->children[b->count][0] = b->children[b->count][1] = -1;
     b->items[b->count++] = *e;
     return 1;
+}
+
+CAROM_API carom_status carom_world_get_event_children(const carom_world *w, int index, int *child_a, int *child_b)
+{
+    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (index < 0 || index >= w->events.count)
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "world_get_event_children: index %d outside 0..%d", index,
+                          w->events.count - 1);
+    if (child_a) *child_a = w->events.children[index][0];
+    if (child_b) *child_b = w->events.children[index][1];
+    return CAROM_OK;
 }
 
 CAROM_API int carom_world_get_events(const carom_world *w, const carom_contact_event **events)

@@ -16,6 +16,8 @@
 typedef struct event_buffer {
     carom_contact_event *items;
     int count, capacity;
+    int (*children)[2];         /* per event: compound child of a and of b, -1 none */
+    int children_capacity;
 } event_buffer;
 
 /* Scratch arrays reused every step (never freed between steps). */
@@ -70,6 +72,8 @@ void world_wake_body(carom_world *w, int slot);
 /* Removes every contact of a body (id index), emitting end events. */
 void world_remove_body_contacts(carom_world *w, int id_index);
 int world_push_event(carom_world *w, const carom_contact_event *e);
+/* Names the compound children of the last pushed event from the contact it came from (collision.c). */
+void world_set_last_event_contact(carom_world *w, int contact_index);
 carom_body_id world_make_id(const carom_world *w, int id_index);
 
 /* Stages of the step, one file each. */

@@ -213,7 +213,8 @@ typedef enum carom_shape_type {
     CAROM_SHAPE_HULL = 4,     /* points (x,y,z triples), point_count >= 4, not coplanar */
     CAROM_SHAPE_PLANE = 5,    /* static only: dot(normal, x) = offset; solid where < offset */
     CAROM_SHAPE_MESH = 6,     /* static or kinematic: triangles, from carom_body_def.mesh */
-    CAROM_SHAPE_HEIGHTFIELD = 7 /* static or kinematic: a grid of heights, from carom_body_def.heightfield */
+    CAROM_SHAPE_HEIGHTFIELD = 7, /* static or kinematic: a grid of heights, from carom_body_def.heightfield */
+    CAROM_SHAPE_COMPOUND = 8  /* several convex children, from carom_body_def.children */
 } carom_shape_type;
 
 /* A triangle mesh, copied at body creation (the body builds its own
@@ -311,6 +312,33 @@ static inline carom_shape_def carom_shape_plane(double nx, double ny, double nz,
     return s;
 }
 
+/* One convex child of a compound body (sphere, box, capsule, cylinder or
+ * hull), with its own pose in the body frame and its own material. The
+ * body's mass, centre of mass and inertia combine the children's exactly. An
+ * array of these is read with the stride of its first element's size. */
+typedef struct carom_compound_child {
+    uint32_t size;            /* sizeof(carom_compound_child), stamped by the default */
+    carom_shape_def shape;
+    carom_vec3 position;      /* the child's origin in the body frame */
+    carom_quat orientation;   /* identity */
+    double friction;          /* 0.6 */
+    double restitution;       /* 0 */
+    double density;           /* 1000 kg/m^3 (the body's mass, when given, rescales all children) */
+} carom_compound_child;
+
+static inline carom_compound_child carom_compound_child_default(carom_shape_def shape)
+{
+    carom_compound_child c;
+    c.size = (uint32_t)sizeof(carom_compound_child);
+    c.shape = shape;
+    c.position.x = 0; c.position.y = 0; c.position.z = 0;
+    c.orientation.w = 1; c.orientation.x = 0; c.orientation.y = 0; c.orientation.z = 0;
+    c.friction = 0.6;
+    c.restitution = 0.0;
+    c.density = 1000.0;
+    return c;
+}
+
 typedef struct carom_body_def {
     uint32_t size;                 /* sizeof(carom_body_def), stamped by the default */
     carom_body_type type;          /* DYNAMIC */
@@ -336,6 +364,8 @@ typedef struct carom_body_def {
     void *user_data;               /* NULL */
     const carom_mesh_def *mesh;    /* NULL: shape.type CAROM_SHAPE_MESH reads it */
     const carom_heightfield_def *heightfield; /* NULL: shape.type CAROM_SHAPE_HEIGHTFIELD reads it */
+    const carom_compound_child *children; /* NULL: shape.type CAROM_SHAPE_COMPOUND reads child_count of them */
+    int child_count;               /* 0 */
 } carom_body_def;
 
 static inline carom_body_def carom_body_def_default(void)
@@ -364,6 +394,8 @@ static inline carom_body_def carom_body_def_default(void)
     d.user_data = 0;
     d.mesh = 0;
     d.heightfield = 0;
+    d.children = 0;
+    d.child_count = 0;
     return d;
 }
 
@@ -490,6 +522,19 @@ CAROM_API int carom_world_ray_cast(const carom_world *world, carom_vec3 origin, 
  * returns the total count (so a second call can size the array); -1 on bad input. */
 CAROM_API int carom_world_query_aabb(const carom_world *world, carom_vec3 lo, carom_vec3 hi,
                                      carom_body_id *ids, int capacity);
+
+/* ---- level geometry and compound bodies --------------------------------- */
+
+/* carom_world_ray_cast, and which part of the body was hit: the child index
+ * of a compound, the triangle index of a mesh (as given at creation), the
+ * cell of a height field times 2 plus its triangle (0 lower, 1 upper);
+ * -1 for other shapes. child may be NULL. */
+CAROM_API int carom_world_ray_cast_child(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
+                                         carom_ray_hit *hit, int *child);
+/* The children event `index` of carom_world_get_events names: the compound
+ * child of a and of b (-1 where that body is not a compound). */
+CAROM_API carom_status carom_world_get_event_children(const carom_world *world, int index, int *child_a,
+                                                      int *child_b);
 
 #ifdef __cplusplus
 }
