@@ -53,6 +53,8 @@ typedef struct clua_shape {
     int *indices;   /* mesh triangles (0-based), height field holes (owned) */
     carom_mesh_def mesh;               /* mesh: points over indices */
     carom_heightfield_def heightfield; /* heightfield: points and indices */
+    carom_compound_child *children;    /* compound (owned; hull children's points in `points`) */
+    int child_count;
 } clua_shape;
 
 /* ---- errors and arguments (carom_lua.c) ---------------------------------- */

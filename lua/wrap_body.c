@@ -133,10 +133,11 @@ int clua_world_add_body(lua_State *L)
     if (clua_field_option(L, 2, fname, "type", clua_body_type_names, &type)) d.type = (carom_body_type)type;
     if (clua_rawfield(L, 2, "shape") == LUA_TNIL) clua_arg_error(L, 2, fname, "shape is required (e.g. shape = carom.sphere{radius = 0.5})");
     clua_shape *s = luaL_testudata(L, -1, CLUA_SHAPE_MT);
-    if (!s) clua_arg_error(L, 2, fname, "shape must be made by carom.sphere, box, capsule, cylinder, hull, plane, mesh or heightfield, got %s", luaL_typename(L, -1));
+    if (!s) clua_arg_error(L, 2, fname, "shape must be made by carom.sphere, box, capsule, cylinder, hull, plane, mesh, heightfield or compound, got %s", luaL_typename(L, -1));
     d.shape = s->def; /* s stays on the stack (so its hull points live) until the body is made */
     if (s->def.type == CAROM_SHAPE_MESH) d.mesh = &s->mesh;
     if (s->def.type == CAROM_SHAPE_HEIGHTFIELD) d.heightfield = &s->heightfield;
+    if (s->def.type == CAROM_SHAPE_COMPOUND) { d.children = s->children; d.child_count = s->child_count; }
     clua_field_vec3(L, 2, fname, "position", &d.position);
     clua_field_vec3(L, 2, fname, "velocity", &d.linear_velocity);
     clua_field_vec3(L, 2, fname, "angular_velocity", &d.angular_velocity);

@@ -11,7 +11,7 @@
 #include "carom_lua.h"
 #include "ranges.h"
 
-const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", "mesh", "heightfield", NULL};
+const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", "mesh", "heightfield", "compound", NULL};
 
 /* Largest hull input accepted here; the world refuses hulls whose result is
  * larger than its narrowphase holds, with its own message. */
@@ -20,7 +20,7 @@ const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", 
 clua_shape *clua_check_shape(lua_State *L, int arg, const char *fname)
 {
     clua_shape *s = luaL_testudata(L, arg, CLUA_SHAPE_MT);
-    if (!s) clua_type_error(L, arg, fname, "shape (carom.sphere, box, capsule, cylinder, hull, plane, mesh or heightfield)");
+    if (!s) clua_type_error(L, arg, fname, "shape (carom.sphere, box, capsule, cylinder, hull, plane, mesh, heightfield or compound)");
     return s;
 }
 
@@ -329,6 +329,75 @@ static int l_heightfield(lua_State *L)
     return 1;
 }
 
+/* carom.compound{ {shape = carom.box{...}, position = {...}, orientation = {...},
+ * friction = 0.6, restitution = 0, density = 1000}, ... }: convex children */
+static int l_compound(lua_State *L)
+{
+    static const char *const child_keys[] = {"shape", "position", "orientation", "friction", "restitution", "density", NULL};
+    clua_check_table(L, 1, "compound");
+    lua_settop(L, 1);
+    lua_Integer n = (lua_Integer)lua_rawlen(L, 1);
+    lua_pushnil(L);
+    while (lua_next(L, 1)) {
+        lua_pop(L, 1);
+        if (!lua_isinteger(L, -1) || lua_tointeger(L, -1) < 1 || lua_tointeger(L, -1) > n)
+            clua_arg_error(L, 1, "compound", "takes a list of children {shape = ..., position = ...}, no named options");
+    }
+    if (n < 1) clua_arg_error(L, 1, "compound", "needs at least one child");
+    if (n > 256) clua_arg_error(L, 1, "compound", "takes at most 256 children, got %d", (int)n);
+    /* the hull children's points, all in one buffer */
+    size_t total = 0;
+    for (lua_Integer i = 1; i <= n; i++) {
+        if (lua_rawgeti(L, 1, i) != LUA_TTABLE) clua_arg_error(L, 1, "compound", "child %d is not a table", (int)i);
+        clua_rawfield(L, lua_gettop(L), "shape");
+        clua_shape *cs = luaL_testudata(L, -1, CLUA_SHAPE_MT);
+        if (!cs) clua_arg_error(L, 1, "compound", "child %d: shape must be made by carom.sphere, box, capsule, cylinder or hull", (int)i);
+        carom_shape_type t = cs->def.type;
+        if (t != CAROM_SHAPE_SPHERE && t != CAROM_SHAPE_BOX && t != CAROM_SHAPE_CAPSULE && t != CAROM_SHAPE_CYLINDER &&
+            t != CAROM_SHAPE_HULL)
+            clua_arg_error(L, 1, "compound", "child %d: shape must be convex (sphere, box, capsule, cylinder or hull), got a %s",
+                           (int)i, clua_shape_names[t]);
+        if (t == CAROM_SHAPE_HULL) total += 3 * (size_t)cs->def.point_count;
+        lua_pop(L, 2);
+    }
+    clua_shape *s = new_shape(L);
+    int self = lua_gettop(L);
+    s->children = calloc((size_t)n, sizeof *s->children);
+    s->points = malloc(sizeof *s->points * (total > 0 ? total : 1));
+    if (!s->children || !s->points) return luaL_error(L, "compound: out of memory");
+    size_t used = 0;
+    for (lua_Integer i = 1; i <= n; i++) {
+        char who[48];
+        snprintf(who, sizeof who, "compound child %d", (int)i);
+        lua_rawgeti(L, 1, i);
+        int ct = lua_gettop(L);
+        clua_check_option_keys(L, ct, who, child_keys, 0);
+        clua_rawfield(L, ct, "shape");
+        const clua_shape *cs = lua_touserdata(L, -1);
+        carom_compound_child c = carom_compound_child_default(cs->def);
+        if (cs->def.type == CAROM_SHAPE_HULL) {
+            memcpy(s->points + used, cs->points, sizeof *s->points * 3 * (size_t)cs->def.point_count);
+            c.shape.points = s->points + used;
+            used += 3 * (size_t)cs->def.point_count;
+        }
+        lua_pop(L, 1);
+        clua_field_vec3(L, ct, who, "position", &c.position);
+        clua_field_quat(L, ct, who, "orientation", &c.orientation);
+        if (clua_field_number(L, ct, who, "friction", &c.friction) && !(c.friction >= 0 && c.friction <= RANGE_FRICTION_MAX))
+            clua_arg_error(L, ct, who, "friction must be in [0, 1e3]");
+        if (clua_field_number(L, ct, who, "restitution", &c.restitution) && !(c.restitution >= 0 && c.restitution <= 1))
+            clua_arg_error(L, ct, who, "restitution must be in [0, 1]");
+        if (clua_field_number(L, ct, who, "density", &c.density) && !(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
+            clua_arg_error(L, ct, who, "density must be in [1e-6, 1e9] kg/m^3");
+        s->children[i - 1] = c;
+        s->child_count = (int)i;
+        lua_settop(L, self);
+    }
+    s->def = carom_shape_sphere(1);
+    s->def.type = CAROM_SHAPE_COMPOUND;
+    return 1;
+}
+
 /* ---- metamethods ----------------------------------------------------------- */
 
 static int shape_gc(lua_State *L)
@@ -336,8 +405,10 @@ static int shape_gc(lua_State *L)
     clua_shape *s = luaL_checkudata(L, 1, CLUA_SHAPE_MT);
     free(s->points);
     free(s->indices);
+    free(s->children);
     s->points = NULL;
     s->indices = NULL;
+    s->children = NULL;
     s->def.points = NULL;
     s->def.point_count = 0;
     return 0;
@@ -366,6 +437,9 @@ static int shape_tostring(lua_State *L)
                  s->heightfield.columns, s->heightfield.cell_x, s->heightfield.cell_y);
         break;
     }
+    case CAROM_SHAPE_COMPOUND:
+        snprintf(buf, sizeof buf, "carom.compound{%d children}", ((const clua_shape *)lua_touserdata(L, 1))->child_count);
+        break;
     default:
         snprintf(buf, sizeof buf, "carom.plane{normal = {%g, %g, %g}, offset = %g}", d->normal.x, d->normal.y, d->normal.z, d->offset);
         break;
@@ -393,7 +467,8 @@ static int shape_eq(lua_State *L)
                    (p->point_count == 0 || memcmp(p->points, q->points, sizeof(double) * 3 * (size_t)p->point_count) == 0);
             break;
         case CAROM_SHAPE_MESH:
-        case CAROM_SHAPE_HEIGHTFIELD: same = a == b; break; /* level geometry: the same descriptor */
+        case CAROM_SHAPE_HEIGHTFIELD:
+        case CAROM_SHAPE_COMPOUND: same = a == b; break; /* the same descriptor */
         default: same = vec_eq(p->normal, q->normal) && p->offset == q->offset; break;
         }
     }
@@ -432,7 +507,8 @@ void clua_open_shapes(lua_State *L)
                                     {"__index", shape_index}, {"__newindex", shape_newindex}, {NULL, NULL}};
     static const luaL_Reg constructors[] = {{"sphere", l_sphere}, {"box", l_box}, {"capsule", l_capsule},
                                             {"cylinder", l_cylinder}, {"hull", l_hull}, {"plane", l_plane},
-                                            {"mesh", l_mesh}, {"heightfield", l_heightfield}, {NULL, NULL}};
+                                            {"mesh", l_mesh}, {"heightfield", l_heightfield}, {"compound", l_compound},
+                                            {NULL, NULL}};
     luaL_newmetatable(L, CLUA_SHAPE_MT);
     luaL_setfuncs(L, meta, 0);
     lua_pushliteral(L, "locked");

@@ -238,7 +238,8 @@ static int world_tostring(lua_State *L)
 
 /* ---- events and callbacks --------------------------------------------------- */
 
-static void push_event(lua_State *L, int world_index, const carom_contact_event *e)
+/* index: the event's place in the world's buffer (for its compound children). */
+static void push_event(lua_State *L, int world_index, const carom_contact_event *e, int index)
 {
     lua_createtable(L, 0, 9);
     lua_pushstring(L, event_names[e->type]);
@@ -259,6 +260,16 @@ static void push_event(lua_State *L, int world_index, const carom_contact_event 
     lua_setfield(L, -2, "speed");
     lua_pushnumber(L, e->average_force);
     lua_setfield(L, -2, "force");
+    /* compound children (1-based), when a or b is a compound */
+    clua_world *lw = lua_touserdata(L, world_index);
+    const carom_contact_event *all;
+    int n = lw && lw->world ? carom_world_get_events(lw->world, &all) : 0;
+    if (index >= 0 && index < n) {
+        int ca = -1, cb = -1;
+        carom_world_get_event_children(lw->world, index, &ca, &cb);
+        if (ca >= 0) { lua_pushinteger(L, ca + 1); lua_setfield(L, -2, "child_a"); }
+        if (cb >= 0) { lua_pushinteger(L, cb + 1); lua_setfield(L, -2, "child_b"); }
+    }
 }
 
 /* Runs protected: 1 = world, 2 = the event (light userdata). Building the
@@ -267,7 +278,11 @@ static int dispatch_event(lua_State *L)
 {
     const carom_contact_event *e = lua_touserdata(L, 2);
     lua_getiuservalue(L, 1, WORLD_UV_CALLBACK);
-    push_event(L, 1, e);
+    /* the callback is handed the world's own buffer entry */
+    clua_world *lw = lua_touserdata(L, 1);
+    const carom_contact_event *all;
+    int n = lw && lw->world ? carom_world_get_events(lw->world, &all) : 0;
+    push_event(L, 1, e, n > 0 && e >= all && e < all + n ? (int)(e - all) : -1);
     lua_call(L, 1, 0);
     return 0;
 }
@@ -384,7 +399,7 @@ static int world_events(lua_State *L)
     if (n > 0) memcpy(copy, events, sizeof *copy * (size_t)n);
     lua_createtable(L, n, 0);
     for (int i = 0; i < n; i++) {
-        push_event(L, 1, &copy[i]);
+        push_event(L, 1, &copy[i], i);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;
@@ -454,7 +469,9 @@ static int world_measure_penetration(lua_State *L)
 
 /* ---- queries ----------------------------------------------------------------- */
 
-/* world:ray_cast(origin, translation): body, point, normal, fraction, or nil. */
+/* world:ray_cast(origin, translation): body, point, normal, fraction, child (the
+ * compound child, mesh triangle or height-field cell*2+half, 1-based; nil for
+ * other shapes), or nil. */
 static int world_ray_cast(lua_State *L)
 {
     clua_world *lw = clua_check_world(L, 1, "ray_cast");
@@ -463,7 +480,8 @@ static int world_ray_cast(lua_State *L)
     clua_check_vec3(L, next, "ray_cast", &translation);
     carom_ray_hit hit;
     lw = clua_check_world(L, 1, "ray_cast");
-    int r = carom_world_ray_cast(lw->world, origin, translation, &hit);
+    int child = -1;
+    int r = carom_world_ray_cast_child(lw->world, origin, translation, &hit, &child);
     char buf[256];
     if (r < 0) return clua_arg_error(L, next, "ray_cast", "%s", clua_copy_error(lw->world, buf, sizeof buf));
     if (r == 0) {
@@ -474,7 +492,9 @@ static int world_ray_cast(lua_State *L)
     clua_push_vec3_table(L, hit.point);
     clua_push_vec3_table(L, hit.normal);
     lua_pushnumber(L, hit.fraction);
-    return 4;
+    if (child >= 0) lua_pushinteger(L, child + 1);
+    else lua_pushnil(L);
+    return 5;
 }
 
 /* world:query_aabb(lo, hi): the bodies whose bounds overlap the box. */

@@ -123,5 +123,51 @@ test("bad input is refused naming the field", function()
   assert(world:body_count() == 0, "the world is unchanged")
 end)
 
+test("compound: mass, a table standing on a mesh, the child in ray casts and events", function()
+  local world = carom.world{}
+  local v, t = grid(6)
+  world:add_body{ type = "static", shape = carom.mesh{ vertices = v, triangles = t } }
+  local children = { { shape = carom.box{ half_extents = {0.6, 0.4, 0.03} }, position = {0, 0, 0.73}, density = 600 } }
+  for i = 0, 3 do
+    children[#children + 1] = { shape = carom.box{ half_extents = {0.03, 0.03, 0.35} },
+                                position = {(i % 2 == 1) and 0.55 or -0.55, (i >= 2) and 0.35 or -0.35, 0.35},
+                                friction = 0.8 }
+  end
+  local table_shape = carom.compound(children)
+  assert(table_shape.type == "compound" and tostring(table_shape) == "carom.compound{5 children}")
+  local tbl = world:add_body{ shape = table_shape, position = {0.2, 0.1, 0} }
+  -- mass: 600 * 1.2 * 0.8 * 0.06 + 4 * 1000 * 0.06 * 0.06 * 0.7
+  local m = 600 * 1.2 * 0.8 * 0.06 + 4 * 1000 * 0.06 * 0.06 * 0.7
+  assert(math.abs(tbl:mass() - m) < 1e-9 * m, "mass " .. tbl:mass())
+  local x0, y0, z0 = tbl:position()
+  world:step(1 / 60, 600)
+  local x, y, z = tbl:position()
+  local moved = math.sqrt((x - x0) ^ 2 + (y - y0) ^ 2 + (z - z0) ^ 2)
+  assert(moved < 1e-3, "the table moved " .. moved)
+  -- a ray down through the top names child 1, one down a leg's corner child 3 (x > 0, y < 0)
+  local hit, point, normal, fraction, child = world:ray_cast({0.2, 0.1, 3}, {0, 0, -5})
+  assert(hit == tbl and child == 1, "top: child " .. tostring(child))
+  local events = {}
+  local w2 = carom.world{}
+  w2:add_body{ type = "static", shape = carom.plane{} }
+  local bell = w2:add_body{ shape = carom.compound{ { shape = carom.sphere{ radius = 0.1 }, position = {-0.5, 0, 0} },
+                                                    { shape = carom.sphere{ radius = 0.1 }, position = {0.5, 0, 0} } },
+                            position = {0, 0, 1}, orientation = {math.cos(0.05), 0, math.sin(0.05), 0} }
+  for i = 1, 60 do
+    w2:step(1 / 60)
+    for _, e in ipairs(w2:events()) do if e.type ~= "end" then events[#events + 1] = e end end
+  end
+  assert(#events > 0, "the dumbbell landed")
+  local e = events[1]
+  local mine = (e.a == bell) and e.child_a or e.child_b
+  assert(mine == 2, "the +x sphere lands first (tilted down at +x): child " .. tostring(mine))
+  -- bad children
+  raises("needs at least one child", carom.compound, {})
+  raises("child 1: shape must be convex", carom.compound, { { shape = carom.plane{} } })
+  raises("child 2 is not a table", carom.compound, { { shape = carom.sphere{ radius = 1 } }, 3 })
+  raises("density must be in", carom.compound, { { shape = carom.sphere{ radius = 1 }, density = 0 } })
+  raises("unknown option", carom.compound, { { shape = carom.sphere{ radius = 1 }, colour = 1 } })
+end)
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end
