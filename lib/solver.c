@@ -539,7 +539,7 @@ int world_solve(carom_world *w, double dt)
             total += p->total_normal_impulse;
             if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
         }
-        if (approach > def->restitution_threshold && total > 0.0) {
+        if (approach > def->hit_event_threshold && total > 0.0) {
             for (int j = 0; j < con->count; j++) {
                 const constraint_point *p = &con->p[j];
                 tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) * substeps;

@@ -77,6 +77,8 @@ static int def_validate(const carom_world_def *d, char *msg, size_t n)
             "position_correction must be SOFT, BAUMGARTE or NONE");
     REQUIRE(d->contact_model == CAROM_CONTACT_IMPULSE || d->contact_model == CAROM_CONTACT_PENALTY,
             "contact_model must be IMPULSE or PENALTY");
+    REQUIRE(isfinite(d->hit_event_threshold) && d->hit_event_threshold >= 0 && d->hit_event_threshold <= RANGE_SPEED_MAX,
+            "hit_event_threshold must be in [0, 1e9] m/s (got %g)", d->hit_event_threshold);
     REQUIRE(d->restitution_threshold >= 0 && d->restitution_threshold <= RANGE_SPEED_MAX,
             "restitution_threshold must be in [0, 1e9] m/s (got %g)", d->restitution_threshold);
     REQUIRE(d->contact_hertz >= RANGE_HERTZ_MIN && d->contact_hertz <= RANGE_HERTZ_MAX,

@@ -33,6 +33,7 @@ static const world_field world_fields[] = {
     FIELD("relax_iterations", relax_iterations, 'i'),
     FIELD("warm_starting", warm_starting, 'b'),
     FIELD("restitution_threshold", restitution_threshold, 'n'),
+    FIELD("hit_event_threshold", hit_event_threshold, 'n'),
     FIELD("hertz", contact_hertz, 'n'),
     FIELD("damping_ratio", contact_damping_ratio, 'n'),
     FIELD("push_velocity", contact_push_max_velocity, 'n'),
@@ -59,7 +60,7 @@ static const world_field world_fields[] = {
 
 static const char *const world_keys[] = {
     "gravity", "preset", "contact_model", "position_correction", "dt", "max_steps",
-    "substeps", "iterations", "relax_iterations", "warm_starting", "restitution_threshold", "hertz",
+    "substeps", "iterations", "relax_iterations", "warm_starting", "restitution_threshold", "hit_event_threshold", "hertz",
     "damping_ratio", "push_velocity", "baumgarte", "linear_slop", "speculative_distance",
     "reuse_distance", "penalty_stiffness", "penalty_damping", "penalty_implicit", "shock_propagation", "friction",
     "restitution", "sleep", "ccd", "sleep_time", "sleep_linear_velocity", "sleep_angular_velocity",

@@ -49,13 +49,15 @@ test("carom.world with the contract's options; settings() reads them back", func
   assert(s.ccd == true and s.sleep == true and s.contact_model == "impulse")
   local w2 = carom.world{ ccd = false, sleep = false, contact_model = "penalty", position_correction = "baumgarte",
                           hertz = 60, damping_ratio = 2, warm_starting = false, shock_propagation = false,
-                          friction = false, restitution = false, restitution_threshold = 0.5, relax_iterations = 2 }
+                          friction = false, restitution = false, restitution_threshold = 0.5, relax_iterations = 2,
+                          hit_event_threshold = 0.25 }
   local s2 = w2:settings()
   assert(s2.ccd == false and s2.sleep == false and s2.contact_model == "penalty")
   assert(s2.position_correction == "baumgarte" and s2.warm_starting == false and s2.shock_propagation == false)
   assert(s2.friction == false and s2.restitution == false and s2.relax_iterations == 2)
   near(s2.hertz, 60, 0, "hertz"); near(s2.damping_ratio, 2, 0, "damping_ratio")
   near(s2.restitution_threshold, 0.5, 0, "restitution_threshold")
+  near(s2.hit_event_threshold, 0.25, 0, "hit_event_threshold")
   assert(carom.world():settings().substeps == 4, "no options: the defaults")
 end)
 

@@ -413,6 +413,50 @@ static void test_large_step_bounce(void **state)
     CHECK_REL(drop_apex("default", 1.0 / 30, 0.5, 0.02), 0.125, 0.03, "apex from 0.5 m, r 0.02");
 }
 
+/* ---- the hit event's own threshold ------------------------------------------- */
+
+/* A plastic ball (e = 0) dropped from 0.1 m meets the floor at sqrt(2 g h) =
+ * 1.40 m/s: a hit event exactly when hit_event_threshold is below that,
+ * whatever restitution_threshold says. */
+static int hits_for(double hit_threshold, double restitution_threshold, double *approach)
+{
+    carom_world_def wd = carom_world_def_default();
+    wd.hit_event_threshold = hit_threshold;
+    wd.restitution_threshold = restitution_threshold;
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.5, 0.0);
+    add_ball(w, 0.1, 1.0, cv(0, 0, 0.2), cv(0, 0, 0), 0.5, 0.0);
+    int hits = 0;
+    for (int i = 0; i < 60; i++) {
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        const carom_contact_event *ev;
+        int n = carom_world_get_events(w, &ev);
+        for (int k = 0; k < n; k++)
+            if (ev[k].type == CAROM_EVENT_HIT) {
+                hits++;
+                *approach = ev[k].approach_speed;
+            }
+    }
+    carom_world_destroy(w);
+    return hits;
+}
+
+static void test_hit_event_threshold_is_its_own_setting(void **state)
+{
+    (void)state;
+    double want = sqrt(2 * G * 0.1), approach = 0.0;
+    assert_int_equal(hits_for(1.0, 1.0, &approach), 1);
+    CHECK_REL(approach, want, 0.02, "hit approach speed");
+    assert_int_equal(hits_for(1.0, 5.0, &approach), 1);
+    assert_int_equal(hits_for(1.0, 0.0, &approach), 1);
+    assert_int_equal(hits_for(2.0, 0.0, &approach), 0);
+    assert_int_equal(hits_for(2.0, 1.0, &approach), 0);
+    carom_world_def wd = carom_world_def_default();
+    wd.hit_event_threshold = -1.0;
+    assert_int_equal(carom_world_def_check(&wd, NULL, 0), CAROM_ERROR_INVALID_ARGUMENT);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -424,6 +468,7 @@ int main(void)
         cmocka_unit_test(test_elastic_gas_default_settings),
         cmocka_unit_test(test_force_driven_bounce),
         cmocka_unit_test(test_large_step_bounce),
+        cmocka_unit_test(test_hit_event_threshold_is_its_own_setting),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

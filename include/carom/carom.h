@@ -106,7 +106,9 @@ typedef struct carom_world_def {
     int relax_iterations;               /* 1: relax passes per sub-step (0 = off) */
     carom_position_correction position_correction; /* SOFT */
     int warm_starting;                  /* 1 */
-    double restitution_threshold;       /* 1.0 m/s: slower impacts do not bounce */
+    double restitution_threshold;       /* 1.0 m/s: slower impacts do not bounce, where gravity
+                                           or forces press the bodies together (the cap is twice
+                                           the closing speed they add in a step; 0 without them) */
     double contact_hertz;               /* 30: soft contact stiffness */
     double contact_damping_ratio;       /* 10 */
     double contact_push_max_velocity;   /* 3 m/s: cap on the speed of push-out */
@@ -136,6 +138,8 @@ typedef struct carom_world_def {
                                            other body since its manifold was computed keeps it
                                            (separations updated to first order); capped at
                                            speculative_distance; 0 = recompute every step */
+    double hit_event_threshold;         /* 1.0 m/s: a contact approaching faster raises a hit
+                                           event (restitution_threshold only decides bounces) */
 } carom_world_def;
 
 static inline carom_world_def carom_world_def_default(void)
@@ -173,6 +177,7 @@ static inline carom_world_def carom_world_def_default(void)
     d.event_callback = 0;
     d.event_context = 0;
     d.contact_reuse_distance = 1e-4;
+    d.hit_event_threshold = 1.0;
     return d;
 }
 
