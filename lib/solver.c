@@ -427,6 +427,9 @@ int world_solve(carom_world *w, double dt)
             p->max_normal_impulse = 0.0;
             if (penalty) {
                 double omega = TWO_PI * contact_hertz;
+                /* the automatic explicit spring (critically damped) stays stable:
+                 * h^2 w^2 + 4 h w < 4 * 0.8 at h w <= 0.6 */
+                if (!def->penalty_implicit && omega * h > 0.6) omega = 0.6 / h;
                 p->penalty_k = def->penalty_stiffness > 0 ? def->penalty_stiffness : p->normal_mass * omega * omega;
                 p->penalty_c = def->penalty_damping > 0 ? def->penalty_damping : 2.0 * p->normal_mass * omega;
                 p->normal_impulse = 0.0;
@@ -436,6 +439,8 @@ int world_solve(carom_world *w, double dt)
             if (!wide) points++;
         }
     }
+
+    if (penalty && !penalty_check(w, cc, ncon, h)) return -1; /* before any body moved */
 
     /* impacts first, at the geometry of the moment of contact (impact.c) */
     int impacts = !penalty && def->enable_restitution;

@@ -97,5 +97,9 @@ static inline void coulomb_clamp(double *t1, double *t2, double limit)
 }
 /* Penalty springs: one sub-step of spring forces (penalty.c). */
 void penalty_solve(carom_world *w, contact_constraint *cc, int n, double h);
+/* (h^2 k + 2 h c) / (4 m): below 1 an explicit spring-damper is stable at sub-step h. */
+double penalty_explicit_stability(double k, double c, double mass, double h);
+/* 0 (with the world's error set) when an explicit spring cannot be integrated at h. */
+int penalty_check(carom_world *w, const contact_constraint *cc, int n, double h);
 
 #endif

@@ -304,7 +304,14 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     if (ok) ok = world_collide(w);
     if (ok) world_remove_ghost_contacts(w);
     double t3 = now_ms();
-    if (ok) ok = world_solve(w, dt);
+    if (ok) {
+        ok = world_solve(w, dt);
+        if (ok < 0) {
+            /* settings the step cannot integrate (world_solve said why): no body moved */
+            w->locked = 0;
+            return CAROM_ERROR_INVALID_ARGUMENT;
+        }
+    }
     double t4 = now_ms();
     if (ok && w->def.enable_continuous) world_continuous(w, dt);
     double t5 = now_ms();

@@ -80,7 +80,7 @@ carom_body_id world_make_id(const carom_world *w, int id_index);
 int world_update_pairs(carom_world *w);                /* collision.c (0 on out of memory) */
 int world_collide(carom_world *w);                     /* collision.c: narrowphase over contacts (0: out of memory) */
 void world_remove_ghost_contacts(carom_world *w);     /* ghost.c: drops contacts on seams between static bodies */
-int world_solve(carom_world *w, double dt);            /* solver.c (0 on out of memory) */
+int world_solve(carom_world *w, double dt);            /* solver.c (0 on out of memory, -1 refused: error set) */
 void world_update_sleep(carom_world *w, double dt);    /* island.c */
 void world_continuous(carom_world *w, double dt);      /* toi.c */
 
