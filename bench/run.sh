@@ -1,9 +1,12 @@
 #!/bin/sh
 # make bench: carom beside ODE and Bullet on the canonical scenes (same run,
 # interleaved), then the broadphase scaling benchmark. Results go to bench/out/.
+# --quick (make bench-quick): only the canonical scenes, one round.
 set -eu
 cd "$(dirname "$0")"
 mkdir -p out
+quick=0
+[ "${1:-}" != --quick ] || { quick=1; RUNS=1; }
 RUNS=${RUNS:-3}
 if ! pkg-config --exists ode bullet 2>/dev/null; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
@@ -18,6 +21,11 @@ if pkg-config --exists ode bullet 2>/dev/null; then
     make -s -C peers all
 else
     mkdir -p peers/build && cp ../build/bench/bench_carom peers/build/
+fi
+if [ "$quick" = 1 ]; then
+    RUNS=1 ./peers/run.sh | tee out/peers_quick.txt
+    echo "bench-quick: bench/out/peers_quick.txt (one round; make bench for 3 rounds and the rest)"
+    exit 0
 fi
 RUNS=$RUNS ./peers/run.sh | tee out/peers.txt
 cp peers/build/raw.txt out/peers_raw.txt

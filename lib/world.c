@@ -9,7 +9,14 @@
 #include "world.h"
 #include "ranges.h"
 
-CAROM_API const char *carom_version(void) { return "1.0.0"; }
+/* "major.minor.patch" from the header's numbers, the one place the version is written */
+#define CAROM_STRINGIFY_(x) #x
+#define CAROM_STRINGIFY(x) CAROM_STRINGIFY_(x)
+CAROM_API const char *carom_version(void)
+{
+    return CAROM_STRINGIFY(CAROM_VERSION_MAJOR) "." CAROM_STRINGIFY(CAROM_VERSION_MINOR) "."
+        CAROM_STRINGIFY(CAROM_VERSION_PATCH);
+}
 
 CAROM_API const char *carom_status_string(carom_status status)
 {

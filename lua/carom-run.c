@@ -3,12 +3,13 @@
  *   carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]
  *                       [--bench] [--record FILE.csv] [--quiet]
  *   carom-run --test script.lua
+ *   carom-run --version
  *
  * A scene is a Lua file returning a table:
  *   { world = {options for carom.world}, steps = N (or seconds = S), dt = DT,
  *     load = function(world) end, update = function(world, dt) end,
  *     contact = function(event) end, report = function(world) end }
- * (every field optional). The runner makes the world, calls load, then for
+ * (every field optional; any other key is an error). The runner makes the world, calls load, then for
  * each step update and world:step(dt) (contact is the world's contact
  * callback), then report. --record writes every body's pose after each step
  * as CSV; --bench prints the median time per step and the accuracy probes.
@@ -27,6 +28,7 @@
 #include <lua.h>
 #include <lauxlib.h>
 #include <lualib.h>
+#include <carom/carom.h>
 
 int luaopen_carom(lua_State *L);
 
@@ -35,45 +37,60 @@ int luaopen_carom(lua_State *L);
 static const char driver_setup[] =
     "local carom = require 'carom'\n"
     "local opts = ...\n"
+    /* errors about the scene file itself: one line, no traceback (see message_handler) */
+    "local function fail(msg) error({ runner_message = msg }) end\n"
     "local chunk, err = loadfile(opts.scene)\n"
-    "if not chunk then error(err, 0) end\n"
+    "if not chunk then fail(err) end\n"
     "local scene = chunk()\n"
     "if type(scene) ~= 'table' then\n"
-    "  error(opts.scene .. ': a scene must return a table {load = ..., update = ..., report = ...}, got ' .. type(scene), 0)\n"
+    "  fail(opts.scene .. ': a scene must return a table {load = ..., update = ..., report = ...}, got ' .. type(scene))\n"
+    "end\n"
+    "local valid = { 'contact', 'dt', 'load', 'report', 'seconds', 'steps', 'update', 'world' }\n"
+    "local is_valid = {}\n"
+    "for _, k in ipairs(valid) do is_valid[k] = true end\n"
+    "for k in pairs(scene) do\n"
+    "  if not is_valid[k] then\n"
+    "    fail(string.format('%s: unknown key %s in the scene table (valid keys: %s)', opts.scene,\n"
+    "      type(k) == 'string' and string.format('%q', k) or '[' .. tostring(k) .. ']', table.concat(valid, ', ')))\n"
+    "  end\n"
     "end\n"
     "for _, k in ipairs{'load', 'update', 'contact', 'report'} do\n"
     "  if scene[k] ~= nil and type(scene[k]) ~= 'function' then\n"
-    "    error(opts.scene .. ': scene.' .. k .. ' must be a function, got ' .. type(scene[k]), 0)\n"
+    "    fail(opts.scene .. ': scene.' .. k .. ' must be a function, got ' .. type(scene[k]))\n"
     "  end\n"
     "end\n"
-    "if scene.world ~= nil and type(scene.world) ~= 'table' then error(opts.scene .. ': scene.world must be a table of world options', 0) end\n"
+    "if scene.world ~= nil and type(scene.world) ~= 'table' then fail(opts.scene .. ': scene.world must be a table of world options') end\n"
     "local function positive_number(v, what, integer)\n"
     "  if v == nil then return nil end\n"
     "  if type(v) ~= 'number' or v ~= v or v <= 0 or v == math.huge or (integer and v % 1 ~= 0) then\n"
-    "    error(opts.scene .. ': scene.' .. what .. ' must be a positive ' .. (integer and 'integer' or 'number'), 0)\n"
+    "    fail(opts.scene .. ': scene.' .. what .. ' must be a positive ' .. (integer and 'integer' or 'number'))\n"
     "  end\n"
     "  return v\n"
     "end\n"
     "local wopts = {}\n"
     "for k, v in pairs(scene.world or {}) do wopts[k] = v end\n"
     "if opts.substeps then wopts.substeps = opts.substeps end\n"
-    "local world = carom.world(wopts)\n"
+    "local made, world = pcall(carom.world, wopts)\n"
+    "if not made then\n"
+    "  local why = tostring(world):gsub('^bad argument #1 to \\'[%w.]*\\' %((.*)%)$', '%1')\n"
+    "  fail(opts.scene .. ': scene.world: ' .. why)\n"
+    "end\n"
     "local dt = opts.dt or positive_number(scene.dt, 'dt') or 1/60\n"
-    "if dt > 1 then error(opts.scene .. ': scene.dt must be at most 1 s', 0) end\n"
+    "if dt > 1 then fail(opts.scene .. ': scene.dt must be at most 1 s') end\n"
     "local function steps_in(seconds) return math.max(1, math.floor(seconds / dt + 0.5)) end\n"
     "local steps = opts.steps or (opts.seconds and steps_in(opts.seconds))\n"
     "  or positive_number(scene.steps, 'steps', true)\n"
     "  or (positive_number(scene.seconds, 'seconds') and steps_in(scene.seconds)) or 600\n"
     "steps = math.tointeger(steps)\n"
-    "if scene.contact then world:set_contact_callback(scene.contact) end\n"
-    "if scene.load then scene.load(world) end\n"
     "local rec\n"
     "if opts.record then\n"
     "  local f, why = io.open(opts.record, 'w')\n"
-    "  if not f then error('cannot write the record file: ' .. why, 0) end\n"
+    "  if not f then fail('cannot write the record file ' .. why) end\n"
     "  rec = f\n"
     "  rec:write('step,t,body,x,y,z,qw,qx,qy,qz\\n')\n"
     "end\n"
+    "if scene.contact then world:set_contact_callback(scene.contact) end\n"
+    "if scene.load then scene.load(world) end\n"
     "local fmt = '%d,%.9g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\\n'\n"
     "local function record(s)\n"
     "  for _, b in ipairs(world:bodies()) do\n"
@@ -132,7 +149,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]\n"
                "                           [--bench] [--record FILE.csv] [--quiet]\n"
-               "       carom-run --test script.lua\n"
+               "       carom-run --test script.lua | --version | --help\n"
                "  --steps N      run N steps (default: the scene's `steps`, else 600)\n"
                "  --seconds S    run S seconds of simulated time\n"
                "  --dt DT        the fixed step in seconds, 0 < DT <= 1 (default: the scene's `dt`, else 1/60)\n"
@@ -142,6 +159,7 @@ static void usage(FILE *f)
                "                 (step,t,body,x,y,z,qw,qx,qy,qz)\n"
                "  --quiet        no progress lines\n"
                "  --test FILE    run a test script (exit status 1 if it fails)\n"
+               "  --version      print the version\n"
                "exit status: 0 success, 1 the scene or script failed, 2 bad command line\n");
 }
 
@@ -156,9 +174,14 @@ static int bad_usage(const char *fmt, ...)
     return 2;
 }
 
+/* Errors the runner raises about the scene file (a table {runner_message =
+ * "..."}) print as one line; a message that carries its own traceback (a
+ * contact callback's, taken where it failed) gets no second one. */
 static int message_handler(lua_State *L)
 {
+    if (lua_istable(L, 1) && lua_getfield(L, 1, "runner_message") == LUA_TSTRING) return 1;
     const char *msg = lua_tostring(L, 1);
+    if (msg && strstr(msg, "\nstack traceback:")) return 1;
     if (!msg) {
         if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) msg = lua_tostring(L, -1);
         else msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
@@ -199,6 +222,9 @@ int main(int argc, char **argv)
         double *target = NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
+            return 0;
+        } else if (!strcmp(a, "--version")) {
+            printf("carom-run %s\n", carom_version());
             return 0;
         } else if (!strcmp(a, "--steps")) target = &steps;
         else if (!strcmp(a, "--seconds")) target = &seconds;

@@ -836,7 +836,7 @@ test("argument tables are read raw: their metamethods never run", function()
 end)
 
 test("the module: version, clock", function()
-  assert(carom.version == "1.0.0")
+  assert(type(carom.version) == "string" and carom.version:match("^%d+%.%d+%.%d+$"), tostring(carom.version))
   local t0 = carom.clock()
   assert(type(t0) == "number" and carom.clock() >= t0)
 end)

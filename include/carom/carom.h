@@ -22,6 +22,7 @@ extern "C" {
 #define CAROM_API
 #endif
 
+/* The version: the one place it is written (the build and carom_version() read it). */
 #define CAROM_VERSION_MAJOR 1
 #define CAROM_VERSION_MINOR 0
 #define CAROM_VERSION_PATCH 0
@@ -74,7 +75,7 @@ typedef struct carom_world carom_world;
 
 /* ---- library ----------------------------------------------------------- */
 
-/* "1.0.0" */
+/* "MAJOR.MINOR.PATCH" of the CAROM_VERSION_* numbers, e.g. "1.0.0" */
 CAROM_API const char *carom_version(void);
 /* Human-readable name of a status. */
 CAROM_API const char *carom_status_string(carom_status status);
