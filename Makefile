@@ -113,6 +113,11 @@ $(RUNNER): lua/carom-run.c $(LUA_SRC) $(STATIC) $(wildcard lua/*.h) | $(BUILD)/l
 	$(CC) $(CFLAGS_ALL) $(LUA_CFLAGS) -DCAROM_RUNNER_STATIC lua/carom-run.c $(LUA_SRC) -o $@ \
 	    $(STATIC) $(LUA_LIBS) $(LDLIBS_ALL) $(SANLD)
 
+# The sanitizer build used to live in build-san/: forward old paths.
+build-san/%: FORCE
+	@echo "($@ is now build/san/$*)"
+	$(MAKE) --no-print-directory SAN=1 build/san/$*
+
 # ---- tests ----------------------------------------------------------------
 # Targets that need the dependencies run `deps` first, then make again, so
 # that nothing of the build is read before the packages are there.
