@@ -439,6 +439,14 @@ static void pairs_in_tree(const broadphase *bp, int tree, int q, bp_pair_fn *fn,
     walk_free(&w);
 }
 
+int bp_is_moved(const broadphase *bp, int proxy) { return bp->leaves[proxy].move_slot >= 0; }
+
+void bp_set_moved(broadphase *bp, int proxy, int moved)
+{
+    if (moved) mark_moved(bp, proxy);
+    else unmark_moved(bp, proxy);
+}
+
 void bp_update_pairs(broadphase *bp, bp_pair_fn *fn, void *ctx)
 {
     for (int m = 0; m < bp->move_count; m++) {

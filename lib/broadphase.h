@@ -31,6 +31,10 @@ void bp_update_pairs(broadphase *bp, bp_pair_fn *fn, void *ctx);
 void bp_query(const broadphase *bp, aabb box, bp_query_fn *fn, void *ctx);
 void bp_ray_cast(const broadphase *bp, vec3 origin, vec3 dir, double max_t, bp_ray_fn *fn, void *ctx);
 int bp_proxy_count(const broadphase *bp);
+/* Whether the proxy is in the moved set (pairs pending for the next
+ * bp_update_pairs), and setting it: snapshots carry the set across. */
+int bp_is_moved(const broadphase *bp, int proxy);
+void bp_set_moved(broadphase *bp, int proxy, int moved);
 
 /* Height of the static or moving tree (-1 when empty; a single proxy is 0). */
 int bp_tree_height(const broadphase *bp, int is_static);

@@ -6,9 +6,29 @@
 #include "array.h"
 #include "world.h"
 
-static void add_pair(void *ctx, int ida, int idb)
+/* The broadphase reports pairs in the order its trees hold them, which
+ * depends on their history; the pairs are added in (id, id) order instead, so
+ * the contact order (and the solver's) depends on the bodies alone and a world
+ * restored from a snapshot, its trees rebuilt, continues bit for bit. */
+static void collect_pair(void *ctx, int ida, int idb)
 {
     carom_world *w = ctx;
+    step_scratch *sc = &w->scratch;
+    if (ida == idb) return;
+    if (!array_reserve((void **)&sc->new_pairs, &sc->new_pair_capacity, sc->new_pair_count + 1, sizeof *sc->new_pairs))
+        return; /* out of memory: the pair is retried when a proxy moves again */
+    uint32_t lo = (uint32_t)(ida < idb ? ida : idb), hi = (uint32_t)(ida < idb ? idb : ida);
+    sc->new_pairs[sc->new_pair_count++] = ((uint64_t)lo << 32) | hi;
+}
+
+static int compare_pairs(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void add_pair(carom_world *w, int ida, int idb)
+{
     body_store *s = &w->bodies;
     int sa = s->ids[ida].slot, sb = s->ids[idb].slot;
     if (sa < 0 || sb < 0 || ida == idb) return;
@@ -54,7 +74,11 @@ int world_update_pairs(carom_world *w)
             bp_move_proxy(w->bp, s->proxy[i], fat);
         }
     }
-    bp_update_pairs(w->bp, add_pair, w);
+    sc->new_pair_count = 0;
+    bp_update_pairs(w->bp, collect_pair, w);
+    qsort(sc->new_pairs, (size_t)sc->new_pair_count, sizeof *sc->new_pairs, compare_pairs);
+    for (int i = 0; i < sc->new_pair_count; i++)
+        add_pair(w, (int)(sc->new_pairs[i] >> 32), (int)(sc->new_pairs[i] & 0xffffffffu));
     return 1;
 }
 

@@ -197,6 +197,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
     free(s->tight_box); free(s->pose); free(s->touching); free(s->wide); free(s->impact);
+    free(s->new_pairs);
     free(w);
 }
 

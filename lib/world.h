@@ -43,6 +43,8 @@ typedef struct step_scratch {
     int impact_bodies;          /* solver bodies impact_resolve recorded, 0: none */
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
+    uint64_t *new_pairs;        /* pairs the broadphase found this step, sorted before they are added */
+    int new_pair_count, new_pair_capacity;
 } step_scratch;
 
 struct carom_world {

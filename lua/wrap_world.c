@@ -116,6 +116,7 @@ static void read_world_options(lua_State *L, int arg, const char *fname, carom_w
 }
 
 static void world_event_callback(void *context, const carom_contact_event *event);
+static clua_world *push_world_userdata(lua_State *L, double fixed_dt, int max_steps);
 
 /* carom.world{options}: a new world. */
 static int l_world(lua_State *L)
@@ -125,25 +126,81 @@ static int l_world(lua_State *L)
     int max_steps = DEFAULT_MAX_STEPS;
     if (!lua_isnoneornil(L, 1)) read_world_options(L, 1, "world", &d, &fixed_dt, &max_steps);
     lua_settop(L, 0);
+    clua_world *lw = push_world_userdata(L, fixed_dt, max_steps);
+    d.event_callback = world_event_callback;
+    d.event_context = lw;
+    lw->world = carom_world_create(&d);
+    if (!lw->world) return luaL_error(L, "world: could not create the world (out of memory)");
+    return 1;
+}
+
+/* The Lua side of a new world userdata (at the top of the stack): its tables. */
+static clua_world *push_world_userdata(lua_State *L, double fixed_dt, int max_steps)
+{
     clua_world *lw = lua_newuserdatauv(L, sizeof *lw, WORLD_UV_COUNT);
     memset(lw, 0, sizeof *lw);
     lw->fixed_dt = fixed_dt;
     lw->max_steps = max_steps;
     luaL_setmetatable(L, CLUA_WORLD_MT);
+    int ud = lua_gettop(L);
     lua_newtable(L); /* proxies: weak values, so unused body userdata can be collected */
     lua_createtable(L, 0, 1);
     lua_pushliteral(L, "v");
     lua_setfield(L, -2, "__mode");
     lua_setmetatable(L, -2);
-    lua_setiuservalue(L, 1, WORLD_UV_PROXIES);
+    lua_setiuservalue(L, ud, WORLD_UV_PROXIES);
     lua_newtable(L);
-    lua_setiuservalue(L, 1, WORLD_UV_IDS);
+    lua_setiuservalue(L, ud, WORLD_UV_IDS);
     lua_newtable(L);
-    lua_setiuservalue(L, 1, WORLD_UV_DATA);
+    lua_setiuservalue(L, ud, WORLD_UV_DATA);
+    return lw;
+}
+
+/* world:snapshot(): the world's complete state as a string (docs/snapshot.md).
+ * Lua-side state is not in it: user_data, the contact callback, advance()'s
+ * backlog. */
+static int world_snapshot(lua_State *L)
+{
+    clua_world *lw = clua_check_world(L, 1, "snapshot");
+    if (lw->stepping) return luaL_error(L, "snapshot: cannot snapshot a world inside its own contact callback");
+    size_t n = carom_world_snapshot(lw->world, NULL, 0);
+    if (n == 0) return luaL_error(L, "snapshot: %s", carom_world_last_error(lw->world));
+    luaL_Buffer b;
+    char *p = luaL_buffinitsize(L, &b, n);
+    if (carom_world_snapshot(lw->world, p, n) != n) return luaL_error(L, "snapshot: the world changed while it was written");
+    luaL_pushresultsize(&b, n);
+    return 1;
+}
+
+/* carom.restore(s): a new world from world:snapshot()'s string; it continues
+ * bit for bit as the snapshotted world would have. Raises on a string that
+ * is not a whole snapshot of this version. */
+static int l_restore(lua_State *L)
+{
+    size_t n;
+    if (lua_type(L, 1) != LUA_TSTRING) return clua_type_error(L, 1, "restore", "string (from world:snapshot())");
+    const char *data = lua_tolstring(L, 1, &n);
+    lua_settop(L, 1);
+    clua_world *lw = push_world_userdata(L, 1.0 / 60.0, DEFAULT_MAX_STEPS);
+    char msg[256];
+    lw->world = carom_world_restore(data, n, msg, sizeof msg);
+    if (!lw->world) return clua_arg_error(L, 1, "restore", "%s", msg);
+    carom_world_def d = carom_world_def_default();
+    carom_world_get_def(lw->world, &d);
     d.event_callback = world_event_callback;
     d.event_context = lw;
-    lw->world = carom_world_create(&d);
-    if (!lw->world) return luaL_error(L, "world: could not create the world (out of memory)");
+    carom_world_set_def(lw->world, &d);
+    /* every body becomes the world's (world:bodies lists them) */
+    int count = carom_world_body_count(lw->world);
+    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(count > 0 ? count : 1), 0);
+    carom_vec3 lo = {-1e300, -1e300, -1e300}, hi = {1e300, 1e300, 1e300};
+    int found = carom_world_query_aabb(lw->world, lo, hi, ids, count);
+    lua_getiuservalue(L, 2, WORLD_UV_IDS);
+    for (int i = 0; i < found && i < count; i++) {
+        lua_pushboolean(L, 1);
+        lua_rawseti(L, -2, (lua_Integer)carom_body_id_pack(ids[i]));
+    }
+    lua_settop(L, 2);
     return 1;
 }
 
@@ -574,7 +631,7 @@ void clua_open_world(lua_State *L)
         {"ray_cast", world_ray_cast}, {"query_aabb", world_query_aabb}, {"bodies", world_bodies},
         {"body_count", world_body_count}, {"configure", world_configure}, {"settings", world_settings},
         {"set_contact_callback", world_set_contact_callback}, {"is_valid", world_is_valid},
-        {"destroy", world_destroy}, {NULL, NULL}};
+        {"destroy", world_destroy}, {"snapshot", world_snapshot}, {NULL, NULL}};
     static const luaL_Reg meta[] = {{"__gc", world_gc}, {"__close", world_close}, {"__tostring", world_tostring},
                                     {NULL, NULL}};
     luaL_newmetatable(L, CLUA_WORLD_MT);
@@ -587,4 +644,6 @@ void clua_open_world(lua_State *L)
     lua_pop(L, 1);
     lua_pushcfunction(L, l_world);
     lua_setfield(L, -2, "world");
+    lua_pushcfunction(L, l_restore);
+    lua_setfield(L, -2, "restore");
 }

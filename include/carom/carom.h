@@ -542,6 +542,22 @@ CAROM_API int carom_world_ray_cast_child(const carom_world *world, carom_vec3 or
 CAROM_API carom_status carom_world_get_event_children(const carom_world *world, int index, int *child_a,
                                                       int *child_b);
 
+/* ---- snapshots ----------------------------------------------------------- */
+
+/* Writes the world's complete state (settings, bodies, shapes, ids and
+ * generations, the contact cache with its warm-start impulses, sleep timers)
+ * into buf in carom's versioned little-endian format (docs/snapshot.md) and
+ * returns its size in bytes. When that is more than capacity nothing usable
+ * is written: call with capacity 0 (buf may be NULL) to learn the size.
+ * Returns 0 for a NULL world or inside the world's step. The event callback,
+ * its context and bodies' user data are pointers and are not written. */
+CAROM_API size_t carom_world_snapshot(const carom_world *world, void *buf, size_t capacity);
+/* A new world from a snapshot; it continues bit for bit as the original
+ * would have. NULL when the data is not a snapshot of this version, is
+ * truncated or corrupted, or memory runs out: msg (if not NULL) says why. The
+ * new world has no event callback and its bodies no user data. */
+CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *msg, size_t msg_size);
+
 #ifdef __cplusplus
 }
 #endif
