@@ -2,9 +2,9 @@
 -- no friction, no gravity) in a row, hit by a sixth at 2 m/s. Ideally the
 -- first ball stops and the last leaves at 2 m/s, keeping momentum (2 kg m/s)
 -- and energy (2 J).
---   a) touching balls: the impacts are simultaneous, and sequential impulses
---      share them out over the row (momentum kept, energy lost, the first ball
---      bounces back): a known limit of the method, shown as it is;
+--   a) touching balls: the impacts arrive together; resolved pair by pair
+--      until none approaches (docs/physics.md, section 4.3), the momentum
+--      runs down the row as in the experiment;
 --   b) balls 5 cm apart: one impact after another, each exact.
 -- carom-run demos/cradle.lua
 local carom = require "carom"

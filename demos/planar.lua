@@ -1,7 +1,7 @@
 -- planar.lua - the seed's real-time 2D sample simulation: the 3D engine
 -- playing a 2D game, every body locked to the x-z plane (lock_to_plane), so
 -- it moves in x and z and turns only about y.
---   1. The seed's impulse for rotating rigid bodies (DIGEST.md, item 8) in
+--   1. The seed's impulse for rotating rigid bodies (docs/physics.md, section 2) in
 --      2D: a puck hits a resting craft (a box) off-centre; the craft leaves
 --      moving and turning, checked against the formula.
 --   2. A break: a cue ball into a triangle of ten balls inside four walls,

@@ -1,4 +1,4 @@
--- seed.lua - the seed's worked examples (seed/DIGEST.md) played through the
+-- seed.lua - the seed's worked examples (docs/physics.md, section 9) played through the
 -- whole engine: bodies, contacts, solver, restitution, friction, events.
 -- Imperial units as in the text (ft, slug, s); no gravity during the impacts.
 -- carom-run demos/seed.lua
@@ -107,7 +107,7 @@ function M.report()
     all = line("spin |w+| (rad/s)", math.sqrt(wx * wx + wy * wy + wz * wz), J * mu * r / I) and all
   end
   for _, l in ipairs(results) do print(l) end
-  print(all and "seed examples: all values match DIGEST.md" or "seed examples: MISMATCH (see above)")
+  print(all and "seed examples: all values match docs/physics.md" or "seed examples: MISMATCH (see above)")
   M.all_match = all
 end
 

@@ -27,7 +27,7 @@ local verdicts = {}
 function M.report()
   print("carom " .. carom.version .. ": rigid bodies that stack, bounce by the book and do not tunnel\n")
 
-  print("1. The seed's worked examples, through the whole engine (seed/DIGEST.md):")
+  print("1. The seed's worked examples, through the whole engine (docs/physics.md, section 9):")
   local seed = play("seed.lua", 1)
   verdicts[#verdicts + 1] = seed.all_match
 

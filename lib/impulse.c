@@ -1,4 +1,4 @@
-/* impulse.c - the seed's collision response (seed/DIGEST.md sections 7-9):
+/* impulse.c - the seed's collision response (docs/physics.md sections 2-3):
  * normal impulse with restitution, its application to linear and angular
  * velocity, and Coulomb friction that never reverses the slip. */
 #include <stddef.h>

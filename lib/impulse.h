@@ -1,4 +1,4 @@
-/* impulse.h - the seed's collision response as pure functions (seed/DIGEST.md).
+/* impulse.h - the seed's collision response as pure functions (docs/physics.md, sections 2-3).
  * The solver calls these; the tests check these.
  *
  * Convention (the seed's): n is a unit normal pointing from body 2 towards

@@ -1,4 +1,4 @@
--- lua_api_test.lua - every line of the Lua contract (DESIGN.md, "Lua
+-- lua_api_test.lua - every line of the Lua contract (docs/lua.md, "The
 -- contract") and every error path of the bindings. Values are checked against
 -- hand computations (free fall, impulse / mass, inertia of a box ...), never
 -- against what the code printed. Run by `make check` as

@@ -1,5 +1,5 @@
 /* test_impulse.c - the seed's collision response (lib/impulse.c) against the
- * worked examples of seed/DIGEST.md (to 4 significant figures) and against
+ * worked examples of docs/physics.md section 9 (to 4 significant figures) and against
  * conservation laws, restitution and the Coulomb bounds over 10,000 random
  * rigid-body pairs, each approaching along n and separating along -n.
  *
@@ -17,12 +17,12 @@
 #include "impulse.h"
 
 /* |got - want| within half a unit of want's 4th significant figure: the value
- * rounds to the same 4 figures as DIGEST.md's (or straddles it by rounding) */
+ * rounds to the same 4 figures as docs/physics.md's (or straddles it by rounding) */
 static void check_sig4(double got, double want, const char *what)
 {
     double tol = 0.5 * pow(10.0, floor(log10(fabs(want))) - 3.0);
     if (!(fabs(got - want) <= tol)) {
-        print_error("%s: got %.9g, DIGEST %.9g (4 significant figures: within %.3g)\n", what, got, want, tol);
+        print_error("%s: got %.9g, worked example %.9g (4 significant figures: within %.3g)\n", what, got, want, tol);
         fail();
     }
 }
@@ -158,7 +158,7 @@ static void test_baseball_and_bat(void **state)
     (void)state;
     const double m1 = 0.069932, m2 = 0.0099556, e = 0.46;
     const double rb = 1.375 / 12.0, rl = 1.47 / 12.0, rs = rb + rl;
-    /* DIGEST's n = (0.87545, 0.48330) points from the bat to the ball
+    /* The worked example's n = (0.87545, 0.48330) points from the bat to the ball
      * (the bat moving +x gives it a positive vrn = 205.73); with the bat as
      * body 1 the convention's normal is its negation */
     vec3 nd = v3(sqrt(rs * rs - rb * rb) / rs, rb / rs, 0.0);
