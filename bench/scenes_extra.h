@@ -284,6 +284,84 @@ static int analytic_run(const char *name, const carom_world_def *def, double *ms
             r->error_name = "energy_drift_rel";
             r->extra = ke1 / ke0;
         }
+    } else if (!strcmp(name, "tumble")) {
+        /* rotation: a torque-free box (0.5 x 0.25 x 0.1 m, 1 kg) about its
+         * intermediate axis at 10 rad/s for 20 s: kinetic energy drift */
+        d.gravity = sx_vec(0, 0, 0);
+        w = carom_world_create(&d);
+        carom_body_def bd = carom_body_def_default();
+        bd.shape = carom_shape_box(0.5, 0.25, 0.1);
+        bd.mass = 1.0;
+        bd.angular_velocity = sx_vec(0.01, 10, 0.01);
+        carom_body_id b = carom_body_create(w, &bd);
+        double ke0, ke1, pe;
+        carom_world_get_energy(w, &ke0, &pe);
+        t0 = bench_now_ms();
+        for (steps = 0; steps < 1200; steps++) carom_world_step(w, dt);
+        elapsed = bench_now_ms() - t0;
+        carom_world_get_energy(w, &ke1, &pe);
+        (void)b;
+        r->error = fabs(ke1 / ke0 - 1.0);
+        r->error_name = "tumble_energy_drift_rel";
+        r->extra = ke1 / ke0;
+    } else if (!strcmp(name, "oblique")) {
+        /* impact geometry: a ball (r 0.1) meets a plane at (4, 0, -3) m/s,
+         * mu 0.1, e 0.5, touching mid-step; the seed's spin out is
+         * mu (1 + e) 3 r / (2/5 r^2) = 11.25 rad/s */
+        d.gravity = sx_vec(0, 0, 0);
+        w = carom_world_create(&d);
+        sx_static_plane(w, 0, 0, 1, 0, 0.1, 0.5);
+        carom_body_def bd = carom_body_def_default();
+        bd.shape = carom_shape_sphere(0.1);
+        bd.mass = 1.0;
+        bd.friction = 0.1;
+        bd.restitution = 0.5;
+        bd.position = sx_vec(0, 0, 0.1 + 3.0 * dt * 3.5);
+        bd.linear_velocity = sx_vec(4, 0, -3);
+        carom_body_id b = carom_body_create(w, &bd);
+        t0 = bench_now_ms();
+        for (steps = 0; steps < 10; steps++) carom_world_step(w, dt);
+        elapsed = bench_now_ms() - t0;
+        carom_vec3 av;
+        carom_body_get_angular_velocity(w, b, &av);
+        double want = 0.1 * 1.5 * 3.0 * 0.1 / (0.4 * 0.01);
+        r->error = fabs(av.y - want) / want;
+        r->error_name = "oblique_spin_rel_err";
+        r->extra = av.y;
+    } else if (!strcmp(name, "break")) {
+        /* simultaneous impacts: 15 billiard balls racked touching, the cue at
+         * 10 m/s, e = 1, mu = 0, no gravity; kinetic energy after 1 s */
+        const double rb = 0.028575;
+        d.gravity = sx_vec(0, 0, 0);
+        w = carom_world_create(&d);
+        carom_body_def bd = carom_body_def_default();
+        bd.shape = carom_shape_sphere(rb);
+        bd.mass = 0.17;
+        bd.friction = 0.0;
+        bd.restitution = 1.0;
+        bd.position = sx_vec(-0.5, 0, 0);
+        bd.linear_velocity = sx_vec(10, 0, 0);
+        carom_body_create(w, &bd);
+        bd.linear_velocity = sx_vec(0, 0, 0);
+        for (int row = 0; row < 5; row++)
+            for (int j = 0; j <= row; j++) {
+                bd.position = sx_vec(row * sqrt(3.0) * rb, (2.0 * j - row) * rb, 0);
+                carom_body_create(w, &bd);
+            }
+        double ke0, ke1, pe;
+        carom_vec3 p0, l0, p1, l1;
+        carom_world_get_energy(w, &ke0, &pe);
+        carom_world_get_momentum(w, &p0, &l0);
+        t0 = bench_now_ms();
+        for (steps = 0; steps < 60; steps++) carom_world_step(w, dt);
+        elapsed = bench_now_ms() - t0;
+        carom_world_get_energy(w, &ke1, &pe);
+        carom_world_get_momentum(w, &p1, &l1);
+        r->error = fabs(ke1 / ke0 - 1.0);
+        r->error_name = "break_energy_rel_err";
+        r->extra = ke1 / ke0;
+        r->momentum_drift = sqrt((p1.x - p0.x) * (p1.x - p0.x) + (p1.y - p0.y) * (p1.y - p0.y) +
+                                 (p1.z - p0.z) * (p1.z - p0.z)) / 1.7;
     } else {
         return 0;
     }
@@ -294,7 +372,8 @@ static int analytic_run(const char *name, const carom_world_def *def, double *ms
 }
 
 static const char *const extra_scene_names[] = {"pyramid", "pile", "stack", "mass_ratio", "bullet", "large_pyramid",
-                                                "bounce", "slide", "incline", "rolling", "gas", "cradle"};
+                                                "bounce", "slide", "incline", "rolling", "gas", "cradle",
+                                                "tumble", "oblique", "break"};
 
 static int extra_scene_count(void) { return (int)(sizeof extra_scene_names / sizeof *extra_scene_names); }
 static const char *extra_scene_name(int i) { return extra_scene_names[i]; }
