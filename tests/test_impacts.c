@@ -413,6 +413,48 @@ static void test_large_step_bounce(void **state)
     CHECK_REL(drop_apex("default", 1.0 / 30, 0.5, 0.02), 0.125, 0.03, "apex from 0.5 m, r 0.02");
 }
 
+/* ---- every shape pair ------------------------------------------------------- */
+
+/* A body landing flat (face, side or lying capsule) on a plane or on a static
+ * box, frictionless, e = 0.5, no gravity: all its contact points meet at once,
+ * so it leaves at e vn straight up without turning, for every shape pair. */
+static void test_flat_landings_every_shape(void **state)
+{
+    (void)state;
+    const carom_shape_def shapes[4] = {carom_shape_box(0.4, 0.3, 0.2), carom_shape_cylinder(0.3, 0.2),
+                                       carom_shape_capsule(0.2, 0.4), carom_shape_sphere(0.25)};
+    /* half heights above the ground; the capsule lies along x */
+    const double half[4] = {0.2, 0.2, 0.2, 0.25};
+    for (int ground = 0; ground < 2; ground++)
+        for (int k = 0; k < 4; k++)
+            for (int p = 0; p < 3; p++) {
+                carom_world *w = world_for(PRESETS[p], cv(0, 0, 0));
+                if (ground == 0) add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.5);
+                else add_static(w, carom_shape_box(3, 3, 0.5), cv(0, 0, -0.5), 0.0, 0.5);
+                carom_body_def d = carom_body_def_default();
+                d.shape = shapes[k];
+                d.mass = 2.0;
+                d.friction = 0.0;
+                d.restitution = 0.5;
+                /* the cylinder's axis is z: standing on its face; the capsule's is z: lay it along x */
+                if (k == 2) { d.orientation.w = sqrt(0.5); d.orientation.y = sqrt(0.5); d.orientation.x = d.orientation.z = 0; }
+                double h = k == 2 ? 0.2 : half[k];
+                d.position = cv(0, 0, h + 2.0 * (1.0 / 60) * 3.3);
+                d.linear_velocity = cv(0, 0, -2.0);
+                carom_body_id id = carom_body_create(w, &d);
+                assert_false(carom_body_id_is_null(id));
+                run(w, 10, 1.0 / 60);
+                carom_vec3 v = velocity(w, id), av = spin(w, id);
+                print_message("%s shape %d on %s: v (%.5f %.5f %.5f), |w| %.2e\n", PRESETS[p], k,
+                              ground ? "a box" : "a plane", v.x, v.y, v.z, len3(av));
+                assert_true(fabs(v.z - 1.0) <= 0.02);
+                assert_true(fabs(v.x) <= 1e-6 && fabs(v.y) <= 1e-6);
+                /* not turning: the rim moves at under 1e-5 of the rebound speed */
+                assert_true(len3(av) * 0.4 <= 1e-5 * 1.0);
+                carom_world_destroy(w);
+            }
+}
+
 /* ---- the hit event's own threshold ------------------------------------------- */
 
 /* A plastic ball (e = 0) dropped from 0.1 m meets the floor at sqrt(2 g h) =
@@ -469,6 +511,7 @@ int main(void)
         cmocka_unit_test(test_force_driven_bounce),
         cmocka_unit_test(test_large_step_bounce),
         cmocka_unit_test(test_hit_event_threshold_is_its_own_setting),
+        cmocka_unit_test(test_flat_landings_every_shape),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
