@@ -17,7 +17,7 @@ SONAME  := libcarom.so.$(VERSION_MAJOR)
 REALNAME := libcarom.so.$(VERSION)
 
 # Packages `deps` installs on Debian (as root): build, test and install-test needs.
-PKGS := pkg-config libccd-dev liblua5.4-dev lua5.4 libcmocka-dev abigail-tools cmake
+PKGS := pkg-config libccd-dev liblua5.4-dev lua5.4 libcmocka-dev abigail-tools cmake clang libclang-rt-dev
 
 # pkg-config is asked when a recipe first needs the flags, never while the
 # Makefile is read: on a fresh machine `deps` installs pkg-config and the .pc
@@ -58,7 +58,9 @@ else
 BUILD   := build
 SANLD   :=
 endif
-CFLAGS_ALL = $(WARN) $(OPT) -fPIC -fvisibility=hidden -DCAROM_BUILDING -Iinclude -Ilib $(CCD_CFLAGS)
+# -ffp-contract=off: no fused multiply-add, so every compiler and flag set
+# computes the same bits (tests/determinism.sh checks it)
+CFLAGS_ALL = $(WARN) $(OPT) -ffp-contract=off -fPIC -fvisibility=hidden -DCAROM_BUILDING -Iinclude -Ilib $(CCD_CFLAGS)
 
 LIB_SRC := $(wildcard lib/*.c)
 LIB_OBJ := $(patsubst lib/%.c,$(BUILD)/obj/%.o,$(LIB_SRC))
@@ -75,7 +77,7 @@ LUA_MOD   := $(BUILD)/lua/carom.so
 RUNNER    := $(BUILD)/carom-run
 LUA_SRC   := $(filter-out lua/carom-run.c,$(wildcard lua/*.c))
 
-.PHONY: all check check-c check-lua test demo bench bench-quick install uninstall abi-check abi-baseline deps clean
+.PHONY: print-cflags all check check-c check-lua test demo bench bench-quick install uninstall abi-check abi-baseline deps clean
 
 all: $(SHARED) $(SHARED_LINKS) $(STATIC) $(RUNNER) $(LUA_MOD)
 
@@ -125,11 +127,14 @@ check: deps
 	$(MAKE) --no-print-directory all
 	$(MAKE) --no-print-directory check-c
 	$(MAKE) --no-print-directory check-lua
+	$(MAKE) --no-print-directory check-fuzz-replay
+	./tests/determinism.sh
 	./tests/install_test.sh
 	./tests/fresh_machine_test.sh
 	$(MAKE) --no-print-directory SAN=1 all
 	$(MAKE) --no-print-directory SAN=1 check-c
 	$(MAKE) --no-print-directory SAN=1 check-lua
+	$(MAKE) --no-print-directory SAN=1 check-fuzz-replay
 	@echo "make check: all tests passed"
 
 test: check
@@ -155,6 +160,11 @@ bench: deps
 bench-quick: deps
 	$(MAKE) --no-print-directory all $(BUILD)/bench/bench_carom
 	./bench/run.sh --quick
+
+include fuzz/fuzz.mk
+
+print-cflags:
+	@echo $(CFLAGS_ALL)
 
 # ---- install --------------------------------------------------------------
 # Every file install writes, so that uninstall removes exactly those.
@@ -225,7 +235,7 @@ abi-baseline: $(SHARED)
 # ---- set-up ---------------------------------------------------------------
 deps:
 	@missing=""; \
-	for c in pkg-config abidw cmake lua5.4; do command -v $$c >/dev/null 2>&1 || missing=1; done; \
+	for c in pkg-config abidw cmake lua5.4 clang; do command -v $$c >/dev/null 2>&1 || missing=1; done; \
 	for p in ccd lua5.4 cmocka; do pkg-config --exists $$p 2>/dev/null || missing=1; done; \
 	if [ -n "$$missing" ]; then \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
@@ -234,7 +244,7 @@ deps:
 	  else \
 	    echo "deps: missing build dependencies. On Debian/Ubuntu run as root:"; \
 	    echo "    apt-get update && apt-get install -y $(PKGS)"; \
-	    echo "(elsewhere install libccd (double precision), Lua 5.4 with headers, cmocka, pkg-config, libabigail and cmake)"; \
+	    echo "(elsewhere install libccd (double precision), Lua 5.4 with headers, cmocka, pkg-config, libabigail, cmake, clang and libFuzzer)"; \
 	    exit 1; \
 	  fi; \
 	fi

@@ -48,3 +48,5 @@ echo "== narrowphase cost per pair type"
 echo
 echo "== the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
 ../build/bench/extremes 1000000 | tee out/extremes.txt
+echo "== snapshots: a settled pile of 10,000 bodies"
+../build/bench/snapshot | tee out/snapshot.txt

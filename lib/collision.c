@@ -76,7 +76,7 @@ int world_update_pairs(carom_world *w)
     }
     sc->new_pair_count = 0;
     bp_update_pairs(w->bp, collect_pair, w);
-    qsort(sc->new_pairs, (size_t)sc->new_pair_count, sizeof *sc->new_pairs, compare_pairs);
+    if (sc->new_pair_count > 1) qsort(sc->new_pairs, (size_t)sc->new_pair_count, sizeof *sc->new_pairs, compare_pairs);
     for (int i = 0; i < sc->new_pair_count; i++)
         add_pair(w, (int)(sc->new_pairs[i] >> 32), (int)(sc->new_pairs[i] & 0xffffffffu));
     return 1;

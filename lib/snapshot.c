@@ -311,7 +311,7 @@ static hull *read_hull(reader *r)
         hf->first = get_i32(r, "hull face first");
         hf->count = get_i32(r, "hull face count");
         if (!r->failed && (hf->count < 3 || hf->first < 0 || hf->first > nfv - hf->count))
-            bad(r, "hull face %d indexes face vertices %d..%d of %d", f, hf->first, hf->first + hf->count, nfv);
+            bad(r, "hull face %d has %d vertices from index %d, of %d", f, hf->count, hf->first, nfv);
         if (!r->failed && fabs(v3_len(hf->normal) - 1.0) > 1e-6) bad(r, "hull face %d normal is not unit", f);
     }
     int total = 0;
@@ -375,7 +375,8 @@ static int read_shape(reader *r, shape *s, int body_type)
 /* ---- the snapshot ------------------------------------------------------------------- */
 
 #define BODY_KNOWN_FLAGS (BODY_LOCK_ROTATION | BODY_LOCK_PLANE | BODY_BULLET | BODY_AWAKE | BODY_ENABLE_SLEEP | BODY_HAS_FORCE)
-#define CONTACT_KNOWN_FLAGS (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_SIM | CONTACT_REUSABLE | CONTACT_APART)
+#define CONTACT_KNOWN_FLAGS \
+    (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_SIM | CONTACT_REUSABLE | CONTACT_APART | CONTACT_ANY_TOUCHING)
 
 static void write_world(writer *o, const carom_world *w)
 {
@@ -426,6 +427,8 @@ static void write_world(writer *o, const carom_world *w)
         put_i32(o, c->id_a);
         put_i32(o, c->id_b);
         put_u32(o, c->flags);
+        put_u32(o, c->sub);
+        put_u32(o, c->sub_limit);
         put_v3(o, c->cache.normal);
         put_u8(o, (unsigned)c->cache.has_normal);
         put_i32(o, c->cache.feature);
@@ -460,6 +463,12 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
         world_fail(w, CAROM_ERROR_LOCKED, "world_snapshot: the world is inside its step; snapshot it afterwards");
         return 0;
     }
+    for (int i = 0; i < w->bodies.count; i++)
+        if (shape_is_composite(&w->bodies.shapes[i])) {
+            /* their format is still to be written (docs/snapshot.md): refuse rather than lose them */
+            world_fail(w, CAROM_ERROR_UNSUPPORTED, "world_snapshot: meshes, height fields and compounds are not in snapshots yet");
+            return 0;
+        }
     if (!buf) capacity = 0;
     writer o = {buf, capacity, 0};
     put_bytes(&o, SNAP_MAGIC, 8);
@@ -602,18 +611,23 @@ static int read_contacts(reader *r, carom_world *w)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
-    int count = get_count(r, 180, 1 << 28, "contact count");
+    int count = get_count(r, 188, 1 << 28, "contact count");
     for (int i = 0; i < count && !r->failed; i++) {
         int a = get_i32(r, "contact body"), b = get_i32(r, "contact body");
         if (r->failed) return 0;
         if (a < 0 || b >= s->id_count || a >= b || s->ids[a].slot < 0 || s->ids[b].slot < 0)
             return bad(r, "contact %d joins ids %d and %d, not two live bodies in order", i, a, b);
-        if (contact_find(cs, a, b) >= 0) return bad(r, "contact %d repeats the pair (%d, %d)", i, a, b);
-        int ci = contact_add(cs, a, b);
+        uint32_t flags = get_u32(r, "contact flags"), sub = get_u32(r, "contact sub");
+        if (r->failed) return 0;
+        if (sub > 1000000) return bad(r, "contact %d has manifold number %u", i, (unsigned)sub);
+        if ((sub ? contact_find_sub(cs, a, b, sub) : contact_find(cs, a, b)) >= 0)
+            return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", i, a, b, (unsigned)sub);
+        int ci = sub ? contact_add_sub(cs, a, b, sub) : contact_add(cs, a, b);
         if (ci < 0) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];
-        c->flags = get_u32(r, "contact flags");
+        c->flags = flags;
+        c->sub_limit = get_u32(r, "contact sub limit");
         c->cache.normal = get_v3(r, "contact cache normal");
         c->cache.has_normal = (int)get_u8(r, "contact cache");
         c->cache.feature = get_i32(r, "contact cache feature");
@@ -674,10 +688,11 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     char why[WORLD_ERROR_SIZE];
     if (carom_world_def_check(&def, why, sizeof why) != CAROM_OK) return bad(&r, "settings: %s", why), NULL;
     if (!(last_dt >= 0 && last_dt <= RANGE_DT_MAX)) return bad(&r, "last dt %g out of range", last_dt), NULL;
+    if (steps >> 63) return bad(&r, "step count out of range"), NULL;
     carom_world *w = carom_world_create(&def);
     if (!w) return bad(&r, "out of memory"), NULL;
     w->last_dt = last_dt;
-    w->stats.step_count = (long long)(steps & 0x7fffffffffffffffULL);
+    w->stats.step_count = (long long)steps;
     if (!read_bodies(&r, w) || !read_contacts(&r, w)) {
         carom_world_destroy(w);
         return NULL;

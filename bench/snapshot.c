@@ -1,0 +1,78 @@
+/* snapshot.c - snapshot size and speed on a settled pile of 10,000 bodies of
+ * mixed shapes (contact cache included): bytes per body, and the median
+ * time of carom_world_snapshot and carom_world_restore over 9 runs each.
+ * Targets (issue 17): <= 256 bytes per body, < 5 ms each. */
+#define _POSIX_C_SOURCE 200809L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "carom/carom.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmp(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv)
+{
+    int n = argc > 1 ? atoi(argv[1]) : 10000;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(w, &g);
+    static const double tetra[] = {0, 0, 0, 0.3, 0, 0, 0, 0.3, 0, 0, 0, 0.3, 0.2, 0.2, 0.2};
+    const carom_shape_def shapes[] = {carom_shape_box(0.2, 0.2, 0.2), carom_shape_sphere(0.2),
+                                      carom_shape_capsule(0.1, 0.15), carom_shape_cylinder(0.15, 0.12),
+                                      carom_shape_hull(tetra, 5)};
+    int side = 50; /* a 50 x 50 footprint, layers of 2500 */
+    for (int i = 0; i < n; i++) {
+        carom_body_def b = carom_body_def_default();
+        b.shape = shapes[i % 5];
+        b.position.x = 0.45 * (i % side) + 0.02 * (i / side % 3);
+        b.position.y = 0.45 * (i / side % side);
+        b.position.z = 0.25 + 0.45 * (i / (side * side));
+        carom_body_create(w, &b);
+    }
+    double t0 = now_ms();
+    int steps = 0;
+    carom_world_stats st = carom_world_stats_init();
+    do {
+        carom_world_step(w, 1.0 / 60);
+        carom_world_get_stats(w, &st);
+        steps++;
+    } while (st.awake_bodies > n / 100 && steps < 1200);
+    printf("pile of %d bodies: %d steps to settle (%.1f s), %d awake, %d broadphase pairs, %d touching manifolds\n", n,
+           steps, (now_ms() - t0) / 1e3, st.awake_bodies, st.pairs, st.contacts);
+    size_t size = carom_world_snapshot(w, NULL, 0);
+    unsigned char *buf = malloc(size);
+    double ts[9], tr[9];
+    for (int k = 0; k < 9; k++) {
+        double a = now_ms();
+        carom_world_snapshot(w, buf, size);
+        ts[k] = now_ms() - a;
+        char msg[256];
+        a = now_ms();
+        carom_world *r = carom_world_restore(buf, size, msg, sizeof msg);
+        tr[k] = now_ms() - a;
+        if (!r) { fprintf(stderr, "restore: %s\n", msg); return 1; }
+        carom_world_destroy(r);
+    }
+    qsort(ts, 9, sizeof ts[0], cmp);
+    qsort(tr, 9, sizeof tr[0], cmp);
+    printf("snapshot: %zu bytes, %.0f bytes per body (target <= 256)\n", size, (double)size / (n + 1));
+    printf("snapshot %.2f ms, restore %.2f ms (medians of 9; target < 5 ms each)\n", ts[4], tr[4]);
+    free(buf);
+    carom_world_destroy(w);
+    return 0;
+}
