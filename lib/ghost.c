@@ -24,6 +24,7 @@
 #include <string.h>
 #include "world.h"
 #include "manifold.h"
+#include "mesh.h"
 
 #define GHOST_COS (1.0 - 1e-12) /* normals this close are one surface's (the reach test decides the rest) */
 
@@ -42,19 +43,40 @@ static int by_dynamic(const void *x, const void *y)
     return a->contact < b->contact ? -1 : (a->contact > b->contact);
 }
 
-/* How far the shape reaches along unit direction n: max over it of dot(n, x). */
-static double reach_along(const shape *s, xform x, vec3 n)
+/* How far the shape reaches along unit direction n: max over it of
+ * dot(n, x), over the part of a mesh or height field within `near` (world
+ * bounds around the dynamic body: a hill elsewhere on the same mesh does
+ * not count). */
+typedef struct reach_query { vec3 n; double best; } reach_query;
+
+static int reach_visit(void *ctx, const vec3 v[3], unsigned active, uint32_t index)
+{
+    reach_query *q = ctx;
+    (void)active; (void)index;
+    for (int k = 0; k < 3; k++) q->best = dmax(q->best, v3_dot(q->n, v[k]));
+    return 1;
+}
+
+static double reach_along(const shape *s, xform x, vec3 n, aabb near)
 {
     if (s->type == SHAPE_PLANE) {
         vec3 pn = q_rotate(x.q, s->plane_normal);
         if (v3_dot(pn, n) < 1.0 - 1e-9) return INFINITY; /* a plane reaches without end except along its normal */
         return s->plane_offset + v3_dot(pn, x.p);
     }
-    if (shape_is_composite(s)) {
-        /* the bounds' corners: exact for flat patches, an over-estimate for hills
-         * (which then keep their contacts, as without this pass) */
-        aabb b = shape_aabb(s, x);
-        return (n.x > 0 ? b.hi.x : b.lo.x) * n.x + (n.y > 0 ? b.hi.y : b.lo.y) * n.y + (n.z > 0 ? b.hi.z : b.lo.z) * n.z;
+    if (s->type == SHAPE_MESH || s->type == SHAPE_HEIGHTFIELD) {
+        /* the world box in the shape's frame: its corners' bounds */
+        aabb local = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+        for (int k = 0; k < 8; k++) {
+            vec3 c = v3(k & 1 ? near.hi.x : near.lo.x, k & 2 ? near.hi.y : near.lo.y, k & 4 ? near.hi.z : near.lo.z);
+            vec3 l = xf_inv_point(x, c);
+            local.lo = v3_min(local.lo, l);
+            local.hi = v3_max(local.hi, l);
+        }
+        reach_query q = {q_inv_rotate(x.q, n), -INFINITY};
+        if (s->type == SHAPE_MESH) mesh_query(s->mesh, local, reach_visit, &q);
+        else heightfield_query(s->field, local, reach_visit, &q);
+        return q.best + v3_dot(n, x.p);
     }
     return v3_dot(n, xf_point(x, shape_support_local(s, q_inv_rotate(x.q, n))));
 }
@@ -196,6 +218,8 @@ void world_remove_ghost_contacts(carom_world *w)
     for (int first = 0; first < n;) {
         int last = first + 1;
         while (last < n && e[last].dynamic == e[first].dynamic) last++;
+        int dyn = s->ids[e[first].dynamic].slot;
+        aabb near = aabb_fatten(shape_aabb(&s->shapes[dyn], body_xform(s, dyn)), w->def.speculative_distance);
         for (int j = first; j < last && last - first > 1; j++) {
             const ghost_entry *gj = &e[j];
             int sj = s->ids[gj->other].slot;
@@ -207,9 +231,10 @@ void world_remove_ghost_contacts(carom_world *w)
                 int si = s->ids[gi->other].slot;
                 xform xi = body_xform(s, si);
                 /* j's body stays under i's plane, and j's normal is not a common surface's */
-                if (!(reach_along(&s->shapes[sj], xj, gi->normal) <= reach_along(&s->shapes[si], xi, gi->normal) + tol))
+                if (!(reach_along(&s->shapes[sj], xj, gi->normal, near) <=
+                      reach_along(&s->shapes[si], xi, gi->normal, near) + tol))
                     continue;
-                if (reach_along(&s->shapes[si], xi, gj->normal) <= reach_along(&s->shapes[sj], xj, gj->normal) + tol)
+                if (reach_along(&s->shapes[si], xi, gj->normal, near) <= reach_along(&s->shapes[sj], xj, gj->normal, near) + tol)
                     continue;
                 sc->touching[gj->listed] = -1;
                 e[j].listed = -1;
