@@ -12,6 +12,7 @@
  * before anything is allocated, every index against its table, every number
  * against the ranges the API enforces; the first failure names what was
  * wrong and nothing is built. */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -213,7 +214,12 @@ static uint64_t checksum(const unsigned char *p, size_t n)
     F(baumgarte) F(linear_slop) F(speculative_distance) I(contact_model) F(penalty_stiffness)                 \
     F(penalty_damping) I(penalty_implicit) I(shock_propagation) I(enable_friction) I(enable_restitution)      \
     I(enable_sleep) I(enable_continuous) F(sleep_time) F(sleep_linear_velocity) F(sleep_angular_velocity)     \
-    F(max_linear_speed) F(max_angular_speed) I(body_capacity) F(contact_reuse_distance)
+    F(max_linear_speed) F(max_angular_speed) I(body_capacity) F(contact_reuse_distance) F(hit_event_threshold)
+
+/* A field appended to carom_world_def must be added above (and to
+ * docs/snapshot.md): this stops the build until it is. */
+typedef char snapshot_def_fields_cover_the_def
+    [offsetof(carom_world_def, hit_event_threshold) + sizeof(double) == sizeof(carom_world_def) ? 1 : -1];
 
 static void write_def(writer *o, const carom_world_def *d)
 {

@@ -187,6 +187,8 @@ static void test_empty_world_and_errors(void **state)
     carom_world_def wd = carom_world_def_default();
     wd.gravity = vec(0, 1, -3);
     wd.substeps = 7;
+    wd.hit_event_threshold = 2.5;
+    wd.contact_reuse_distance = 3e-3;
     carom_world *w = carom_world_create(&wd);
     snap s = take(w);
     char msg[256];
@@ -195,6 +197,7 @@ static void test_empty_world_and_errors(void **state)
     carom_world_def got = carom_world_def_default();
     carom_world_get_def(r, &got);
     assert_true(got.gravity.y == 1 && got.gravity.z == -3 && got.substeps == 7);
+    assert_true(got.hit_event_threshold == 2.5 && got.contact_reuse_distance == 3e-3);
     assert_int_equal(carom_world_snapshot(NULL, NULL, 0), 0);
     assert_null(carom_world_restore(NULL, 10, msg, sizeof msg));
     assert_non_null(strstr(msg, "NULL"));
