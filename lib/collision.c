@@ -44,11 +44,11 @@ static void add_pair(carom_world *w, int ida, int idb)
     d->restitution = dmax(s->restitution[a], s->restitution[b]);
 }
 
-int world_update_pairs(carom_world *w)
+int world_update_pairs(carom_world *w, const step_context *ctx)
 {
     body_store *s = &w->bodies;
     step_scratch *sc = &w->scratch;
-    double dt = w->last_dt;
+    double dt = ctx->dt;
     if (!array_reserve((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
     /* the pose array shares the capacity: grow it to match */
     int cap = sc->slot_capacity;
@@ -279,12 +279,12 @@ static void wake_for_step(carom_world *w, int slot)
     w->scratch.tight_box[slot] = shape_aabb(&s->shapes[slot], w->scratch.pose[slot]);
 }
 
-int world_collide(carom_world *w)
+int world_collide(carom_world *w, const step_context *ctx)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     double speculative = w->def.speculative_distance;
-    double dt = w->last_dt;
+    double dt = ctx->dt;
     step_scratch *sc = &w->scratch;
     /* within the look-ahead, a feature not yet in a manifold cannot reach
      * contact while the manifold is kept */

@@ -3,7 +3,7 @@
 #ifndef CAROM_IMPACT_H
 #define CAROM_IMPACT_H
 
-#include "solver.h"
+#include "constraint.h"
 
 /* Resolves this step's impacts on the step's starting velocities (bodies[]):
  * each manifold with restitution whose bodies touch, or will touch within dt

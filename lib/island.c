@@ -14,8 +14,9 @@ static int find_root(int *parent, int i)
     return i;
 }
 
-void world_update_sleep(carom_world *w, double dt)
+void world_update_sleep(carom_world *w, const step_context *ctx)
 {
+    double dt = ctx->dt;
     body_store *s = &w->bodies;
     const carom_world_def *def = &w->def;
     step_scratch *sc = &w->scratch;

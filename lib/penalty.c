@@ -11,7 +11,7 @@
  * overshoots where points share a body: a 10-box stack rocked and fell over
  * within 3 s (top moved 9.8 m). */
 #include <stdio.h>
-#include "solver.h"
+#include "penalty.h"
 
 /* sweeps of the implicit springs per sub-step: a 10-box column at default
  * settings (sleep off) drifts sideways 15 cm in 10 s at 8 sweeps, 2-11 cm at
@@ -27,15 +27,18 @@ double penalty_explicit_stability(double k, double c, double mass, double h)
     return mass > 0.0 ? (h * h * k + 2.0 * h * c) / (4.0 * mass) : 0.0;
 }
 
-int penalty_check(carom_world *w, const contact_constraint *cc, int n, double h)
+int penalty_check(const step_context *ctx, char *msg, size_t msg_size)
 {
-    if (w->def.penalty_implicit) return 1;
+    const contact_constraint *cc = ctx->constraints;
+    int n = ctx->constraint_count;
+    double h = ctx->h;
+    if (ctx->penalty_implicit) return 1;
     for (int k = 0; k < n; k++)
         for (int i = 0; i < cc[k].count; i++) {
             const constraint_point *p = &cc[k].p[i];
             double r = penalty_explicit_stability(p->penalty_k, p->penalty_c, p->normal_mass, h);
             if (r >= PENALTY_EXPLICIT_MARGIN) {
-                world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                snprintf(msg, msg_size,
                            "step: explicit penalty spring k %g N/m, c %g N s/m on effective mass %g kg is "
                            "unstable at sub-step %g s (h^2 k/m + 2 h c/m = %.3g >= %.3g): use penalty_implicit = 1, "
                            "a smaller penalty_stiffness or more substeps",
@@ -58,12 +61,15 @@ static void friction_rows(impulse_body *A, impulse_body *B, contact_constraint *
     impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, l1 - o1), v3_scale(c->t2, l2 - o2)));
 }
 
-void penalty_solve(carom_world *w, contact_constraint *cc, int n, double h)
+void penalty_solve(const step_context *ctx)
 {
-    impulse_body *bodies = w->scratch.bodies;
-    const vec3 *dp = w->scratch.delta_position, *dq = w->scratch.delta_rotation;
-    int implicit = w->def.penalty_implicit;
-    int friction_on = w->def.enable_friction;
+    impulse_body *bodies = ctx->bodies;
+    const vec3 *dp = ctx->dp, *dq = ctx->dq;
+    contact_constraint *cc = ctx->constraints;
+    int n = ctx->constraint_count;
+    double h = ctx->h;
+    int implicit = ctx->penalty_implicit;
+    int friction_on = ctx->friction;
     for (int k = 0; k < n; k++)
         for (int i = 0; i < cc[k].count; i++) {
             cc[k].p[i].normal_impulse = 0.0;

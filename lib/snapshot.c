@@ -389,7 +389,7 @@ static void write_world(writer *o, const carom_world *w)
     const body_store *s = &w->bodies;
     const contact_set *cs = &w->contacts;
     write_def(o, &w->def);
-    put_f64(o, w->last_dt);
+    put_f64(o, 0.0); /* reserved: was the last step's dt (each step now carries its own) */
     put_u64(o, (uint64_t)w->stats.step_count);
 
     put_i32(o, s->id_count);
@@ -688,7 +688,7 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
 
     carom_world_def def;
     read_def(&r, &def);
-    double last_dt = get_f64(&r, "last dt");
+    double last_dt = get_f64(&r, "reserved f64"); /* was the last step's dt: read, checked, unused */
     uint64_t steps = get_u64(&r, "step count");
     if (r.failed) return NULL;
     char why[WORLD_ERROR_SIZE];
@@ -697,7 +697,6 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (steps >> 63) return bad(&r, "step count out of range"), NULL;
     carom_world *w = carom_world_create(&def);
     if (!w) return bad(&r, "out of memory"), NULL;
-    w->last_dt = last_dt;
     w->stats.step_count = (long long)steps;
     if (!read_bodies(&r, w) || !read_contacts(&r, w)) {
         carom_world_destroy(w);

@@ -7,11 +7,12 @@
  * the same number of points are packed four to a batch, field by field. Each
  * manifold is still solved point by point exactly as in solver.c; only the
  * order between manifolds becomes colour by colour. Manifolds beyond the last
- * colour keep the scalar pass. */
+ * colour keep the scalar passes (contact_solver.c). The AVX2 and SSE2 builds
+ * of the passes come from one source (WIDE_PASSES below). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include "solver.h"
+#include "solver_wide.h"
 
 #define LANES 4
 
@@ -63,6 +64,13 @@ struct wide_set {
     int batch_count, overflow_count;
     int avx2;                    /* run the AVX2 build of the passes */
 };
+
+/* One build of the passes over every batch (WIDE_PASSES). */
+typedef struct wide_passes {
+    double (*prepare)(const wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm);
+    void (*warm)(const wide_set *ws, impulse_body *bodies);
+    void (*solve)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces);
+} wide_passes;
 
 static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
 
@@ -259,15 +267,16 @@ LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body 
     scatter(wb, bodies, &lb);
 }
 
-/* The scalar solve_constraint (solver.c), four manifolds at a time. */
-LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_context *sc, int use_bias)
+/* The scalar contact_solve (contact_solver.c), four manifolds at a time. */
+LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_context *ctx, int use_bias,
+                             int hold_bounces)
 {
     lane_bodies lb;
-    gather(wb, sc->bodies, &lb);
-    const vec3 *pa0 = &sc->dp[wb->a[0]], *pa1 = &sc->dp[wb->a[1]], *pa2 = &sc->dp[wb->a[2]], *pa3 = &sc->dp[wb->a[3]];
-    const vec3 *pb0 = &sc->dp[wb->b[0]], *pb1 = &sc->dp[wb->b[1]], *pb2 = &sc->dp[wb->b[2]], *pb3 = &sc->dp[wb->b[3]];
-    const vec3 *qa0 = &sc->dq[wb->a[0]], *qa1 = &sc->dq[wb->a[1]], *qa2 = &sc->dq[wb->a[2]], *qa3 = &sc->dq[wb->a[3]];
-    const vec3 *qb0 = &sc->dq[wb->b[0]], *qb1 = &sc->dq[wb->b[1]], *qb2 = &sc->dq[wb->b[2]], *qb3 = &sc->dq[wb->b[3]];
+    gather(wb, ctx->bodies, &lb);
+    const vec3 *pa0 = &ctx->dp[wb->a[0]], *pa1 = &ctx->dp[wb->a[1]], *pa2 = &ctx->dp[wb->a[2]], *pa3 = &ctx->dp[wb->a[3]];
+    const vec3 *pb0 = &ctx->dp[wb->b[0]], *pb1 = &ctx->dp[wb->b[1]], *pb2 = &ctx->dp[wb->b[2]], *pb3 = &ctx->dp[wb->b[3]];
+    const vec3 *qa0 = &ctx->dq[wb->a[0]], *qa1 = &ctx->dq[wb->a[1]], *qa2 = &ctx->dq[wb->a[2]], *qa3 = &ctx->dq[wb->a[3]];
+    const vec3 *qb0 = &ctx->dq[wb->b[0]], *qb1 = &ctx->dq[wb->b[1]], *qb2 = &ctx->dq[wb->b[2]], *qb3 = &ctx->dq[wb->b[3]];
     lane_t dpa[3], dp[3], dqa[3], dqb[3];
     SET_LANES(dpa[0], pa0, pa1, pa2, pa3, x);
     SET_LANES(dpa[1], pa0, pa1, pa2, pa3, y);
@@ -282,32 +291,29 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
     SET_LANES(dqb[0], qb0, qb1, qb2, qb3, x);
     SET_LANES(dqb[1], qb0, qb1, qb2, qb3, y);
     SET_LANES(dqb[2], qb0, qb1, qb2, qb3, z);
-    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(sc->inv_h), push = SPLAT(-sc->push_max);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(ctx->inv_h), push = SPLAT(-ctx->push_max);
     /* bias, mass and impulse scales of a penetrating point (speculative ones differ per lane below) */
     lane_t pen_mass_scale = one, pen_impulse_scale = zero;
-    int soft = use_bias && sc->correction == CAROM_CORRECTION_SOFT;
-    int baumgarte = use_bias && sc->correction == CAROM_CORRECTION_BAUMGARTE;
+    int soft = use_bias && ctx->correction == CAROM_CORRECTION_SOFT;
+    int baumgarte = use_bias && ctx->correction == CAROM_CORRECTION_BAUMGARTE;
     if (soft) {
         pen_mass_scale = wb->mass_scale;
         pen_impulse_scale = wb->impulse_scale;
     }
-    const lane_t baum_rate = SPLAT(sc->baumgarte * sc->inv_h), slop = SPLAT(sc->slop);
+    const lane_t baum_rate = SPLAT(ctx->baumgarte_rate), slop = SPLAT(ctx->slop);
     for (int i = 0; i < wb->count; i++) {
         wide_point *p = &pts[i];
         /* current separation: small-angle update of the anchors */
         lane_t s = p->base_separation + DOT3(wb->n, dp) + DOT3(dqb, p->rb_n) - DOT3(dqa, p->ra_n);
         lane_t pen_bias = zero;
-        if (soft) {
-            lane_t b = wb->bias_rate * s;
-            pen_bias = LANE_MAX(b, push);
-        } else if (baumgarte) {
-            lane_t e = s + slop;
-            lane_t b = baum_rate * LANE_MIN(e, zero);
-            pen_bias = LANE_MAX(b, push);
+        if (soft || baumgarte) {
+            lane_t rate = wb->bias_rate;
+            pen_bias = CONTACT_PUSH_BIAS(soft, s, rate, baum_rate, slop, push, zero, LANE_MAX, LANE_MIN);
         }
         /* speculative (s > 0): arrive exactly at contact, rigidly */
         lane_mask ahead = s > zero;
-        lane_t bias = SELECT_LANES(ahead, s * inv_h, pen_bias);
+        lane_t spec = CONTACT_SPECULATIVE_BIAS(s, inv_h);
+        lane_t bias = SELECT_LANES(ahead, spec, pen_bias);
         lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
         lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
         lane_t vn = wb->n[0] * (lb.vb[0] - lb.va[0]) + wb->n[1] * (lb.vb[1] - lb.va[1]) + wb->n[2] * (lb.vb[2] - lb.va[2]) +
@@ -315,7 +321,7 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
         lane_t old = p->normal_impulse;
         lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
         total = LANE_MAX(total, zero);
-        if (sc->hold_bounces) {
+        if (hold_bounces) {
             lane_mask hold = ahead & (wb->restitution > zero);
             total = SELECT_LANES(hold, LANE_MIN(total, old), total);
         }
@@ -332,7 +338,7 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
             lb.wb[d] += lambda * p->ib_n[d];
         }
     }
-    if (sc->friction) {
+    if (ctx->friction) {
         for (int i = 0; i < wb->count; i++) {
             wide_point *p = &pts[i];
             lane_t dv[3] = {lb.vb[0] - lb.va[0], lb.vb[1] - lb.va[1], lb.vb[2] - lb.va[2]};
@@ -340,14 +346,13 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
             lane_t v2 = DOT3(dv, wb->t2) + DOT3(lb.wb, p->rb_t[1]) - DOT3(lb.wa, p->ra_t[1]);
             lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
             lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-            /* Coulomb's cone, as coulomb_clamp: scale back to |t| <= mu * normal */
+            /* Coulomb's cone (coulomb_factor): scale back to |t| <= mu * normal */
             lane_t limit = wb->friction * p->normal_impulse;
             lane_t mag2 = n1 * n1 + n2 * n2;
             lane_mask over = mag2 > limit * limit;
             if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
-                lane_t f = one;
-                for (int l = 0; l < LANES; l++)
-                    if (over[l]) f[l] = limit[l] / sqrt(mag2[l]);
+                lane_t f;
+                for (int l = 0; l < LANES; l++) f[l] = coulomb_factor(mag2[l], limit[l]);
                 n1 *= f;
                 n2 *= f;
             }
@@ -363,7 +368,7 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const solve_
             }
         }
     }
-    scatter(wb, sc->bodies, &lb);
+    scatter(wb, ctx->bodies, &lb);
 }
 
 /* Lane l of a batch reads manifold l (an empty lane reads zeros: static body,
@@ -493,9 +498,8 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
         p->max_normal_impulse = zero;
         for (int l = 0; l < wb->lanes; l++) {
             constraint_point *cold = &c[l]->p[i];
-            double v = vn[l], an = c[l]->gravity_closing, s = sep[l];
-            if (v < 0.0 && s > 0.0 && an < 0.0) v = -sqrt(v * v - 2.0 * an * s); /* as solver.c: speed at impact */
-            cold->relative_velocity = v;
+            double s = sep[l];
+            cold->relative_velocity = contact_approach_velocity(vn[l], c[l]->gravity_closing, s);
             cold->base_separation = s;
             cold->total_normal_impulse = 0.0;
             cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
@@ -509,98 +513,83 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     return deepest;
 }
 
-static double prepare_batches(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm)
-{
-    double deepest = 0.0;
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));
-    }
-    return deepest;
-}
+/* The passes over every batch, written once and built twice: for the base
+ * target (SSE2 on x86-64) and, chosen at run time, for AVX2 (one register per
+ * four lanes instead of two, and twice the registers). No FMA: rounding stays
+ * the same in both builds, so results do not depend on the machine. */
+#define WIDE_PASSES(SUFFIX, TARGET)                                                                     \
+    TARGET static double prepare_batches##SUFFIX(const wide_set *ws, contact_constraint *cc,             \
+                                                 const impulse_body *bodies, double warm)                \
+    {                                                                                                    \
+        double deepest = 0.0;                                                                            \
+        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));        \
+        }                                                                                                \
+        return deepest;                                                                                  \
+    }                                                                                                    \
+    TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies)                    \
+    {                                                                                                    \
+        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            warm_batch(wb, &ws->points[wb->first], bodies);                                              \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET static void solve_batches##SUFFIX(const wide_set *ws, const step_context *ctx, int use_bias,  \
+                                             int hold_bounces)                                           \
+    {                                                                                                    \
+        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces);                        \
+        }                                                                                                \
+    }                                                                                                    \
+    static const wide_passes passes##SUFFIX = {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX};
 
-static void warm_batches(wide_set *ws, impulse_body *bodies)
-{
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        warm_batch(wb, &ws->points[wb->first], bodies);
-    }
-}
-
-static void solve_batches(wide_set *ws, const solve_context *sc, int use_bias)
-{
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        solve_batch(wb, &ws->points[wb->first], sc, use_bias);
-    }
-}
-
+WIDE_PASSES(_base, )
 #if WIDE_AVX2
-/* The same passes compiled for AVX2 (one register per four lanes instead of
- * two, and twice the registers), chosen at run time. No FMA: rounding stays
- * the same as the SSE2 build, so results do not depend on the machine. */
-__attribute__((target("avx2"))) static void warm_batches_avx2(wide_set *ws, impulse_body *bodies)
-{
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        warm_batch(wb, &ws->points[wb->first], bodies);
-    }
-}
-
-__attribute__((target("avx2"))) static double prepare_batches_avx2(wide_set *ws, contact_constraint *cc,
-                                                                   const impulse_body *bodies, double warm)
-{
-    double deepest = 0.0;
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));
-    }
-    return deepest;
-}
-
-__attribute__((target("avx2"))) static void solve_batches_avx2(wide_set *ws, const solve_context *sc, int use_bias)
-{
-    for (int k = 0; k < ws->batch_count; k++) {
-        wide_batch *wb = &ws->batches[k];
-        solve_batch(wb, &ws->points[wb->first], sc, use_bias);
-    }
-}
-#endif
+WIDE_PASSES(_avx2, __attribute__((target("avx2"))))
 #endif
 
-double wide_prepare(wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm)
+
+/* The build of the passes this set runs. */
+static const wide_passes *passes_for(const wide_set *ws)
 {
 #if WIDE_AVX2
-    if (ws->avx2) return prepare_batches_avx2(ws, cc, bodies, warm);
-    return prepare_batches(ws, cc, bodies, warm);
-#elif WIDE_VECTORS
-    return prepare_batches(ws, cc, bodies, warm);
+    if (ws->avx2) return &passes_avx2;
+#endif
+    (void)ws;
+    return &passes_base;
+}
+
+double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
+{
+    return passes_for(ws)->prepare(ws, cc, ctx->bodies, ctx->warm_starting ? 1.0 : 0.0);
+}
+
+void wide_warm_start(const wide_set *ws, impulse_body *bodies) { passes_for(ws)->warm(ws, bodies); }
+
+void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces)
+{
+    passes_for(ws)->solve(ws, ctx, use_bias, hold_bounces);
+}
 #else
-    (void)ws; (void)cc; (void)bodies; (void)warm;
+/* no vectors: no batches, every manifold is in the overflow */
+double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
+{
+    (void)ws; (void)cc; (void)ctx;
     return 0.0;
-#endif
 }
-
-void wide_warm_start(wide_set *ws, contact_constraint *cc, impulse_body *bodies)
+void wide_warm_start(const wide_set *ws, impulse_body *bodies) { (void)ws; (void)bodies; }
+void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces)
 {
-#if WIDE_AVX2
-    if (ws->avx2) warm_batches_avx2(ws, bodies);
-    else warm_batches(ws, bodies);
-#elif WIDE_VECTORS
-    warm_batches(ws, bodies);
-#endif
-    for (int k = 0; k < ws->overflow_count; k++) warm_start_constraint(&cc[ws->overflow[k]], bodies);
+    (void)ws; (void)ctx; (void)use_bias; (void)hold_bounces;
 }
-
-void wide_solve(wide_set *ws, contact_constraint *cc, const solve_context *sc, int use_bias)
-{
-#if WIDE_AVX2
-    if (ws->avx2) solve_batches_avx2(ws, sc, use_bias);
-    else solve_batches(ws, sc, use_bias);
-#elif WIDE_VECTORS
-    solve_batches(ws, sc, use_bias);
 #endif
-    for (int k = 0; k < ws->overflow_count; k++) solve_constraint(&cc[ws->overflow[k]], sc, use_bias);
+
+int wide_overflow(const wide_set *ws, const int **list)
+{
+    *list = ws->overflow;
+    return ws->overflow_count;
 }
 
 void wide_read_impulses(const wide_set *ws, contact_constraint *c)

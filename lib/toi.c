@@ -86,16 +86,14 @@ static int sweep_against(void *ctx, int id_index)
     return 1;
 }
 
-void world_continuous(carom_world *w, double dt)
+void world_continuous(carom_world *w, const step_context *ctx)
 {
     body_store *s = &w->bodies;
-    step_scratch *sc = &w->scratch;
-    (void)dt;
     for (int i = 0; i < s->count; i++) {
         if (s->type[i] != CAROM_BODY_DYNAMIC || !(s->flags[i] & BODY_AWAKE)) continue;
         int k = s->solver_index[i];
         if (k <= 0) continue;
-        vec3 delta = sc->delta_position[k];
+        vec3 delta = ctx->dp[k];
         double travel = v3_len(delta);
         int bullet = (s->flags[i] & BODY_BULLET) != 0;
         if (!bullet && travel <= min_extent(&s->shapes[i])) continue;

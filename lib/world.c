@@ -8,6 +8,7 @@
 #include "array.h"
 #include "world.h"
 #include "ranges.h"
+#include "solver.h"
 
 /* "major.minor.patch" from the header's numbers, the one place the version is written */
 #define CAROM_STRINGIFY_(x) #x
@@ -299,7 +300,8 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "step: dt must be in [1e-6, 1] seconds (got %g)", dt);
     double t0 = now_ms();
     w->locked = 1;
-    w->last_dt = dt;
+    step_context ctx;
+    step_context_init(&ctx, &w->def, dt);
     w->events.count = 0;
     w->stats.clamped = 0;
     w->stats.toi_events = 0;
@@ -307,13 +309,13 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     double t1 = now_ms();
     /* out of memory in a stage stops the step there: later stages read what
      * the earlier ones produced this step */
-    int ok = world_update_pairs(w);
+    int ok = world_update_pairs(w, &ctx);
     double t2 = now_ms();
-    if (ok) ok = world_collide(w);
+    if (ok) ok = world_collide(w, &ctx);
     if (ok) world_remove_ghost_contacts(w);
     double t3 = now_ms();
     if (ok) {
-        ok = world_solve(w, dt);
+        ok = world_solve(w, &ctx);
         if (ok < 0) {
             /* settings the step cannot integrate (world_solve said why): no body moved */
             w->locked = 0;
@@ -321,9 +323,9 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
         }
     }
     double t4 = now_ms();
-    if (ok && w->def.enable_continuous) world_continuous(w, dt);
+    if (ok && w->def.enable_continuous) world_continuous(w, &ctx);
     double t5 = now_ms();
-    if (ok) world_update_sleep(w, dt);
+    if (ok) world_update_sleep(w, &ctx);
     double t6 = now_ms();
 
     w->stats.ms_broadphase = t2 - t1;

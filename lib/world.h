@@ -8,6 +8,7 @@
 #include "broadphase.h"
 #include "contact.h"
 #include "impulse.h"
+#include "step.h"
 
 #define WORLD_ERROR_SIZE 256
 /* Fat AABB margin (m): a body moves this far before its proxy is re-inserted. */
@@ -57,7 +58,6 @@ struct carom_world {
     carom_world_stats stats;
     int locked;                 /* inside step or a callback */
     int in_callback;
-    double last_dt;
     char error[WORLD_ERROR_SIZE];
 };
 
@@ -78,12 +78,11 @@ int world_push_event(carom_world *w, const carom_contact_event *e);
 void world_set_last_event_contact(carom_world *w, int contact_index);
 carom_body_id world_make_id(const carom_world *w, int id_index);
 
-/* Stages of the step, one file each. */
-int world_update_pairs(carom_world *w);                /* collision.c (0 on out of memory) */
-int world_collide(carom_world *w);                     /* collision.c: narrowphase over contacts (0: out of memory) */
-void world_remove_ghost_contacts(carom_world *w);     /* ghost.c: drops contacts on seams between static bodies */
-int world_solve(carom_world *w, double dt);            /* solver.c (0 on out of memory, -1 refused: error set) */
-void world_update_sleep(carom_world *w, double dt);    /* island.c */
-void world_continuous(carom_world *w, double dt);      /* toi.c */
+/* Stages of the step, one file each; the solver's is in solver.h. */
+int world_update_pairs(carom_world *w, const step_context *ctx);  /* collision.c (0 on out of memory) */
+int world_collide(carom_world *w, const step_context *ctx);       /* collision.c: narrowphase (0: out of memory) */
+void world_remove_ghost_contacts(carom_world *w);                 /* ghost.c: drops contacts on seams between static bodies */
+void world_update_sleep(carom_world *w, const step_context *ctx); /* island.c */
+void world_continuous(carom_world *w, const step_context *ctx);   /* toi.c */
 
 #endif

@@ -1,0 +1,85 @@
+/* constraint.h - a contact constraint (one touching manifold) and its points,
+ * as every pass reads them, and the formulas the passes share: written once
+ * here for the scalar passes (contact_solver.c, one manifold a call), the
+ * wide passes (solver_wide.c, four a call), the shock pass and the penalty
+ * springs. */
+#ifndef CAROM_CONSTRAINT_H
+#define CAROM_CONSTRAINT_H
+
+#include "contact.h"
+#include "step.h"
+
+/* Hot fields first, in the order the solve pass reads them: the normal row,
+ * then the friction rows; what only preparation, restitution or the shock
+ * and penalty paths read comes last. */
+typedef struct constraint_point {
+    double base_separation;
+    double normal_mass, normal_impulse;
+    double total_normal_impulse, max_normal_impulse;
+    vec3 ra_n, rb_n;             /* ra x n, rb x n */
+    vec3 ia_n, ib_n;             /* IA^-1 (ra x n), IB^-1 (rb x n) */
+    double tangent_mass[2], tangent_impulse[2];
+    vec3 ra_t[2], rb_t[2];       /* ra x t_k, rb x t_k (friction rows) */
+    vec3 ia_t[2], ib_t[2];       /* IA^-1 (ra x t_k), IB^-1 (rb x t_k) */
+    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
+    double relative_velocity;    /* normal velocity before solving (restitution) */
+    double penalty_k, penalty_c; /* penalty model spring and damper */
+    double shock_normal;         /* shock pass impulse: this pass only, never warm-started */
+} constraint_point;
+
+typedef struct contact_constraint {
+    int a, b;                    /* solver bodies (0 = the shared static body) */
+    int contact;                 /* index in the contact set */
+    int count;
+    int level;                   /* shock propagation: lower of the two body levels */
+    vec3 n, t1, t2;
+    double friction, restitution;
+    softness soft;
+    constraint_point *p;         /* count points in the step's packed point array */
+    int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
+    /* what preparing the points reads */
+    const manifold *m;
+    const contact_point_state *warm; /* last step's impulses, matched by feature */
+    vec3 center_a, center_b;     /* centres of mass */
+    double gravity_closing;      /* normal acceleration of b relative to a from gravity and forces */
+} contact_constraint;
+
+/* ---- the shared formulas ------------------------------------------------ */
+
+/* Push-out bias of a penetrating row (separation s <= 0; a speculative row,
+ * s > 0, takes CONTACT_SPECULATIVE_BIAS instead). `soft` selects the soft
+ * spring's rate over Baumgarte's beta / h past the slop; both are capped at
+ * the push-out speed (neg_push = -push_max). Written over any number type:
+ * the scalar passes give dmax/dmin, the wide passes the lanes' max/min. */
+#define CONTACT_PUSH_BIAS(soft, s, bias_rate, baumgarte_rate, slop, neg_push, zero, MAX, MIN) \
+    ((soft) ? MAX((bias_rate) * (s), (neg_push))                                             \
+            : MAX((baumgarte_rate) * MIN((s) + (slop), (zero)), (neg_push)))
+/* A speculative row (s > 0) arrives exactly at contact within the sub-step. */
+#define CONTACT_SPECULATIVE_BIAS(s, inv_h) ((s) * (inv_h))
+
+/* The normal velocity restitution answers: a gap that closes under gravity
+ * (gravity_closing < 0) before the impact arrives faster than it started,
+ * v^2 = v0^2 + 2 |a| gap. */
+static inline double contact_approach_velocity(double vn, double gravity_closing, double separation)
+{
+    if (vn < 0.0 && separation > 0.0 && gravity_closing < 0.0)
+        return -sqrt(vn * vn - 2.0 * gravity_closing * separation);
+    return vn;
+}
+
+/* Coulomb's cone: the factor that scales a friction impulse of squared
+ * length mag2 back to |t| <= limit (1 inside the cone). */
+static inline double coulomb_factor(double mag2, double limit)
+{
+    return mag2 > limit * limit ? limit / sqrt(mag2) : 1.0;
+}
+
+/* Coulomb's cone on (t1, t2). */
+static inline void coulomb_clamp(double *t1, double *t2, double limit)
+{
+    double f = coulomb_factor(*t1 * *t1 + *t2 * *t2, limit);
+    *t1 *= f;
+    *t2 *= f;
+}
+
+#endif

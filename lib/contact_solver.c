@@ -1,0 +1,203 @@
+/* contact_solver.c - the scalar passes over one manifold: prepare, warm
+ * start, solve / relax and the shock pass. The wide passes
+ * (solver_wide.c) do the same four manifolds at a time; the formulas they
+ * share are in constraint.h. */
+#include "contact_solver.h"
+
+#define TWO_PI 6.283185307179586
+
+double contact_prepare(contact_constraint *c, const step_context *ctx)
+{
+    impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
+    vec3 ca = c->center_a, cb = c->center_b;
+    double ws = ctx->warm_starting ? 1.0 : 0.0;
+    double deepest = 0.0;
+    for (int j = 0; j < c->count; j++) {
+        const manifold_point *mp = &c->m->points[j];
+        constraint_point *p = &c->p[j];
+        p->ra = v3_sub(mp->point, ca);
+        p->rb = v3_sub(mp->point, cb);
+        p->ra_n = v3_cross(p->ra, c->n);
+        p->rb_n = v3_cross(p->rb, c->n);
+        p->ia_n = m3_mulv(A->inv_inertia, p->ra_n);
+        p->ib_n = m3_mulv(B->inv_inertia, p->rb_n);
+        p->ra_t[0] = v3_cross(p->ra, c->t1);
+        p->rb_t[0] = v3_cross(p->rb, c->t1);
+        p->ra_t[1] = v3_cross(p->ra, c->t2);
+        p->rb_t[1] = v3_cross(p->rb, c->t2);
+        for (int q = 0; q < 2; q++) {
+            p->ia_t[q] = m3_mulv(A->inv_inertia, p->ra_t[q]);
+            p->ib_t[q] = m3_mulv(B->inv_inertia, p->rb_t[q]);
+        }
+        /* the seed's denominator 1/m1 + 1/m2 + n.((I1^-1 (r1 x n)) x r1) + ..., from the
+         * rows above: n.((I^-1 (r x n)) x r) = (I^-1 (r x n)).(r x n) */
+        double kn = A->inv_mass + B->inv_mass + v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
+        double k1 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
+        double k2 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
+        p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
+        p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
+        p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
+        p->base_separation = mp->separation;
+        p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n),
+                                                         c->gravity_closing, mp->separation);
+        p->normal_impulse = ws * c->warm[j].normal_impulse;
+        p->tangent_impulse[0] = ws * c->warm[j].tangent_impulse[0];
+        p->tangent_impulse[1] = ws * c->warm[j].tangent_impulse[1];
+        p->total_normal_impulse = 0.0;
+        p->max_normal_impulse = 0.0;
+        if (ctx->penalty) {
+            double omega = TWO_PI * ctx->contact_hertz;
+            /* the automatic explicit spring (critically damped) stays stable:
+             * h^2 w^2 + 4 h w < 4 * 0.8 at h w <= 0.6 */
+            if (!ctx->penalty_implicit && omega * ctx->h > 0.6) omega = 0.6 / ctx->h;
+            p->penalty_k = ctx->penalty_stiffness > 0 ? ctx->penalty_stiffness : p->normal_mass * omega * omega;
+            p->penalty_c = ctx->penalty_damping > 0 ? ctx->penalty_damping : 2.0 * p->normal_mass * omega;
+            p->normal_impulse = 0.0;
+            p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
+        }
+        if (-mp->separation > deepest) deepest = -mp->separation;
+    }
+    return deepest;
+}
+
+void contact_warm_start(contact_constraint *c, impulse_body *bodies)
+{
+    impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
+                        v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
+        p->total_normal_impulse += p->normal_impulse;
+        /* seed convention: body 1 = B receives +P (n points from A to B) */
+        impulse_apply(B, A, p->rb, p->ra, P);
+    }
+}
+
+/* Normal then friction rows of one manifold; use_bias selects the solve pass
+ * (position error fed back) over the relax pass (velocity only). */
+void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces)
+{
+    impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
+    vec3 vA = A->v, wA = A->w, vB = B->v, wB = B->w;
+    double mA = A->inv_mass, mB = B->inv_mass;
+    vec3 n = c->n;
+    vec3 dpab = v3_sub(ctx->dp[c->b], ctx->dp[c->a]);
+    vec3 dqa = ctx->dq[c->a], dqb = ctx->dq[c->b];
+    int soft = ctx->correction == CAROM_CORRECTION_SOFT;
+    int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        /* current separation: small-angle update of the anchors */
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, p->rb_n) - v3_dot(dqa, p->ra_n);
+        double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
+        if (s > 0.0) {
+            bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
+        } else if (push) {
+            bias = CONTACT_PUSH_BIAS(soft, s, c->soft.bias_rate, ctx->baumgarte_rate, ctx->slop, -ctx->push_max, 0.0,
+                                     dmax, dmin);
+            if (soft) {
+                mass_scale = c->soft.mass_scale;
+                impulse_scale = c->soft.impulse_scale;
+            }
+        }
+        double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, p->rb_n) - v3_dot(wA, p->ra_n);
+        double lambda = -p->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
+        double total = p->normal_impulse + lambda;
+        if (total < 0.0) total = 0.0;
+        if (hold_bounces && s > 0.0 && c->restitution > 0.0 && total > p->normal_impulse) total = p->normal_impulse;
+        lambda = total - p->normal_impulse;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        if (total > p->max_normal_impulse) p->max_normal_impulse = total;
+        vA = v3_madd(vA, -mA * lambda, n);
+        wA = v3_madd(wA, -lambda, p->ia_n);
+        vB = v3_madd(vB, mB * lambda, n);
+        wB = v3_madd(wB, lambda, p->ib_n);
+    }
+    if (ctx->friction && c->friction > 0) {
+        vec3 dv = v3_sub(vB, vA);
+        for (int i = 0; i < c->count; i++) {
+            constraint_point *p = &c->p[i];
+            double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+            double v1 = v3_dot(dv, c->t1) + v3_dot(wB, p->rb_t[0]) - v3_dot(wA, p->ra_t[0]);
+            double v2 = v3_dot(dv, c->t2) + v3_dot(wB, p->rb_t[1]) - v3_dot(wA, p->ra_t[1]);
+            double n1 = o1 - p->tangent_mass[0] * v1;
+            double n2 = o2 - p->tangent_mass[1] * v2;
+            coulomb_clamp(&n1, &n2, c->friction * p->normal_impulse);
+            p->tangent_impulse[0] = n1;
+            p->tangent_impulse[1] = n2;
+            double d1 = n1 - o1, d2 = n2 - o2;
+            vec3 P = v3_add(v3_scale(c->t1, d1), v3_scale(c->t2, d2));
+            vA = v3_madd(vA, -mA, P);
+            vB = v3_madd(vB, mB, P);
+            wA = v3_sub(wA, v3_add(v3_scale(p->ia_t[0], d1), v3_scale(p->ia_t[1], d2)));
+            wB = v3_add(wB, v3_add(v3_scale(p->ib_t[0], d1), v3_scale(p->ib_t[1], d2)));
+            dv = v3_sub(vB, vA);
+        }
+    }
+    A->v = vA; A->w = wA;
+    B->v = vB; B->w = wB;
+}
+
+/* Shock propagation (Guendelman et al. 2003): the body nearer the ground is
+ * treated as immovable, so a heavy body is held by the light body under it
+ * instead of slowly crushing it (an iterative solver converges at a rate set
+ * by the mass ratio). Constraints arrive sorted bottom-up. */
+void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces, int lower_is_a)
+{
+    impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
+    /* fa, fb scale each body's response: the lower body gets 0 */
+    double fa = lower_is_a ? 0.0 : 1.0, fb = lower_is_a ? 1.0 : 0.0;
+    vec3 n = c->n;
+    vec3 dpab = v3_sub(ctx->dp[c->b], ctx->dp[c->a]);
+    int soft = ctx->correction == CAROM_CORRECTION_SOFT;
+    int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        /* rows from the anchors: a wide-solved point keeps only those */
+        vec3 ra_n = v3_cross(p->ra, n), rb_n = v3_cross(p->rb, n);
+        vec3 ia_n = m3_mulv(A->inv_inertia, ra_n), ib_n = m3_mulv(B->inv_inertia, rb_n);
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(ctx->dq[c->b], rb_n) - v3_dot(ctx->dq[c->a], ra_n);
+        double k = fa * (A->inv_mass + v3_dot(ra_n, ia_n)) + fb * (B->inv_mass + v3_dot(rb_n, ib_n));
+        p->shock_normal = 0.0;
+        if (k <= 0) continue;
+        /* rigid against an immovable lower body, with the soft push-out rate */
+        double bias = 0.0;
+        if (s > 0.0) bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
+        else if (push)
+            bias = CONTACT_PUSH_BIAS(soft, s, c->soft.bias_rate, ctx->baumgarte_rate, ctx->slop, -ctx->push_max, 0.0,
+                                     dmax, dmin);
+        double vn = v3_dot(n, v3_sub(B->v, A->v)) + v3_dot(B->w, rb_n) - v3_dot(A->w, ra_n);
+        /* the pass may pull back at most what the regular solve pushed */
+        double lambda = dmax(-(vn + bias) / k, -p->normal_impulse);
+        if (hold_bounces && s > 0.0 && c->restitution > 0.0 && lambda > 0.0) lambda = 0.0;
+        p->shock_normal = lambda;
+        p->total_normal_impulse += lambda;
+        A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
+        A->w = v3_madd(A->w, -fa * lambda, ia_n);
+        B->v = v3_madd(B->v, fb * B->inv_mass * lambda, n);
+        B->w = v3_madd(B->w, fb * lambda, ib_n);
+    }
+    if (!ctx->friction || c->friction <= 0) return;
+    for (int i = 0; i < c->count; i++) {
+        constraint_point *p = &c->p[i];
+        vec3 vp = v3_sub(v3_add(B->v, v3_cross(B->w, p->rb)), v3_add(A->v, v3_cross(A->w, p->ra)));
+        vec3 t[2] = {c->t1, c->t2};
+        double nw[2];
+        for (int j = 0; j < 2; j++) {
+            vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
+            double k = fa * (A->inv_mass + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
+                       fb * (B->inv_mass + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
+            nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
+        }
+        /* Coulomb on the total: what the regular pass used plus this pass */
+        double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        double t1 = o1 + nw[0], t2 = o2 + nw[1];
+        coulomb_clamp(&t1, &t2, c->friction * dmax(p->normal_impulse + p->shock_normal, 0.0));
+        vec3 P = v3_add(v3_scale(t[0], t1 - o1), v3_scale(t[1], t2 - o2));
+        A->v = v3_madd(A->v, -fa * A->inv_mass, P);
+        A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
+        B->v = v3_madd(B->v, fb * B->inv_mass, P);
+        B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(p->rb, P)), fb));
+    }
+}

@@ -1,0 +1,30 @@
+/* solver_wide.h - the wide passes: constraints coloured so that none in a
+ * colour shares a moving body, packed four to a batch and solved four at a
+ * time. The manifolds no colour takes (the overflow) are left to the scalar
+ * passes (contact_solver.h), which the caller runs after each wide pass. */
+#ifndef CAROM_SOLVER_WIDE_H
+#define CAROM_SOLVER_WIDE_H
+
+#include "constraint.h"
+
+typedef struct wide_set wide_set;
+/* Colours the constraints and lays out the batches in *mem (grown as
+ * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
+ * and filling the batch headers; NULL on out of memory. */
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
+/* The constraints left to the scalar passes, in order. */
+int wide_overflow(const wide_set *ws, const int **list);
+/* Prepares every batched manifold's points four lanes at a time, as
+ * contact_prepare does one; their scalar points get what the shock pass,
+ * restitution and the events read. Returns the deepest overlap. */
+double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx);
+void wide_warm_start(const wide_set *ws, impulse_body *bodies);
+/* use_bias: the solve pass, else relax; hold_bounces: see contact_solve. */
+void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces);
+/* Copies a batched constraint's current impulses to its scalar points (the
+ * shock pass reads them between wide passes). */
+void wide_read_impulses(const wide_set *ws, contact_constraint *c);
+/* Writes the batches' impulses back to the constraints' points. */
+void wide_store(const wide_set *ws, contact_constraint *cc);
+
+#endif
