@@ -26,6 +26,14 @@
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
 
+/* On a little-endian host the bytes are the value's own: one copy (the
+ * portable byte loops below are the definition, and the big-endian path). */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define SNAP_HOST_LE 1
+#else
+#define SNAP_HOST_LE 0
+#endif
+
 typedef struct writer {
     unsigned char *buf;
     size_t cap, pos;
@@ -41,7 +49,8 @@ static void put_u64(writer *o, uint64_t v)
 {
     if (o->pos + 8 <= o->cap) {
         unsigned char *b = o->buf + o->pos;
-        for (int i = 0; i < 8; i++) b[i] = (unsigned char)(v >> (8 * i));
+        if (SNAP_HOST_LE) memcpy(b, &v, 8);
+        else for (int i = 0; i < 8; i++) b[i] = (unsigned char)(v >> (8 * i));
     }
     o->pos += 8;
 }
@@ -50,7 +59,8 @@ static void put_u32(writer *o, uint32_t v)
 {
     if (o->pos + 4 <= o->cap) {
         unsigned char *b = o->buf + o->pos;
-        for (int i = 0; i < 4; i++) b[i] = (unsigned char)(v >> (8 * i));
+        if (SNAP_HOST_LE) memcpy(b, &v, 4);
+        else for (int i = 0; i < 4; i++) b[i] = (unsigned char)(v >> (8 * i));
     }
     o->pos += 4;
 }
@@ -114,7 +124,8 @@ static uint64_t get_u64(reader *r, const char *what)
 {
     if (!need(r, 8, what)) return 0;
     uint64_t v = 0;
-    for (int i = 7; i >= 0; i--) v = (v << 8) | r->buf[r->pos + (size_t)i];
+    if (SNAP_HOST_LE) memcpy(&v, r->buf + r->pos, 8);
+    else for (int i = 7; i >= 0; i--) v = (v << 8) | r->buf[r->pos + (size_t)i];
     r->pos += 8;
     return v;
 }
@@ -123,7 +134,8 @@ static uint32_t get_u32(reader *r, const char *what)
 {
     if (!need(r, 4, what)) return 0;
     uint32_t v = 0;
-    for (int i = 3; i >= 0; i--) v = (v << 8) | r->buf[r->pos + (size_t)i];
+    if (SNAP_HOST_LE) memcpy(&v, r->buf + r->pos, 4);
+    else for (int i = 3; i >= 0; i--) v = (v << 8) | r->buf[r->pos + (size_t)i];
     r->pos += 4;
     return v;
 }
@@ -193,7 +205,8 @@ static uint64_t checksum(const unsigned char *p, size_t n)
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
         uint64_t v = 0;
-        for (int k = 7; k >= 0; k--) v = (v << 8) | p[i + (size_t)k];
+        if (SNAP_HOST_LE) memcpy(&v, p + i, 8);
+        else for (int k = 7; k >= 0; k--) v = (v << 8) | p[i + (size_t)k];
         h = (h ^ v) * 0xff51afd7ed558ccdULL;
         h ^= h >> 29;
     }
