@@ -708,8 +708,13 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (carom_world_def_check(&def, why, sizeof why) != CAROM_OK) return bad(&r, "settings: %s", why), NULL;
     if (!(last_dt >= 0 && last_dt <= RANGE_DT_MAX)) return bad(&r, "last dt %g out of range", last_dt), NULL;
     if (steps >> 63) return bad(&r, "step count out of range"), NULL;
+    /* the storage hint is kept but not acted on: the store is sized for the
+     * bodies the snapshot holds, never for a number the data merely claims */
+    int capacity_hint = def.body_capacity;
+    def.body_capacity = 0;
     carom_world *w = carom_world_create(&def);
     if (!w) return bad(&r, "out of memory"), NULL;
+    w->def.body_capacity = capacity_hint;
     w->stats.step_count = (long long)steps;
     if (!read_bodies(&r, w) || !read_contacts(&r, w)) {
         carom_world_destroy(w);
