@@ -28,12 +28,6 @@ static int quat_ok(carom_quat q)
     return isfinite(l2) && fabs(sqrt(l2) - 1.0) <= 1e-6;
 }
 
-carom_body_id world_make_id(const carom_world *w, int id_index)
-{
-    carom_body_id id = {(uint32_t)id_index + 1, w->bodies.ids[id_index].generation};
-    return id;
-}
-
 CAROM_API int carom_body_is_valid(const carom_world *w, carom_body_id id)
 {
     return w && body_store_slot(&w->bodies, id.index1, id.generation) >= 0;
@@ -55,33 +49,6 @@ static int lookup(const carom_world *w, carom_body_id id, const char *fn)
     if ((w)->locked) return world_fail((w), CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", (fn));
 #define REQUIRE_OUT(p, fn)                                                         \
     if (!(p)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: output pointer is NULL", (fn));
-
-aabb world_body_fat_aabb(const carom_world *w, int slot, double margin)
-{
-    aabb box = shape_aabb(&w->bodies.shapes[slot], body_xform(&w->bodies, slot));
-    return aabb_fatten(box, margin + w->def.speculative_distance);
-}
-
-void world_wake_body(carom_world *w, int slot)
-{
-    body_store *s = &w->bodies;
-    if (s->type[slot] == CAROM_BODY_STATIC) return;
-    s->flags[slot] |= BODY_AWAKE;
-    s->sleep_time[slot] = 0;
-}
-
-void world_remove_body_contacts(carom_world *w, int id_index)
-{
-    contact_set *cs = &w->contacts;
-    for (int i = cs->count - 1; i >= 0; i--)
-        if (cs->items[i].id_a == id_index || cs->items[i].id_b == id_index) {
-            /* wake the other body: what rested on this one must fall */
-            int other = cs->items[i].id_a == id_index ? cs->items[i].id_b : cs->items[i].id_a;
-            int oslot = w->bodies.ids[other].slot;
-            if (oslot >= 0) world_wake_body(w, oslot);
-            contact_remove(cs, i);
-        }
-}
 
 static void refresh_proxy(carom_world *w, int slot)
 {
@@ -463,10 +430,8 @@ CAROM_API carom_status carom_body_destroy(carom_world *w, carom_body_id id)
         return CAROM_OK;
     }
     REQUIRE_UNLOCKED(w, "body_destroy");
-    world_remove_body_contacts(w, (int)id.index1 - 1);
-    bp_destroy_proxy(w->bp, w->bodies.proxy[slot]);
-    shape_free_data(&w->bodies.shapes[slot]);
-    body_store_remove(&w->bodies, slot);
+    (void)slot;
+    world_destroy_body(w, (int)id.index1 - 1);
     return CAROM_OK;
 }
 

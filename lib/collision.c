@@ -5,6 +5,7 @@
 #include <string.h>
 #include "array.h"
 #include "world.h"
+#include "events.h"
 
 /* The broadphase reports pairs in the order its trees hold them, which
  * depends on their history; the pairs are added in (id, id) order instead, so
@@ -80,23 +81,6 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     for (int i = 0; i < sc->new_pair_count; i++)
         add_pair(w, (int)(sc->new_pairs[i] >> 32), (int)(sc->new_pairs[i] & 0xffffffffu));
     return 1;
-}
-
-static void push_touch_event(carom_world *w, int contact_index, carom_event_type type)
-{
-    const contact *c = &w->contacts.items[contact_index];
-    const contact_data *d = &w->contacts.data[contact_index];
-    carom_contact_event e;
-    memset(&e, 0, sizeof e);
-    e.type = type;
-    e.a = world_make_id(w, c->id_a);
-    e.b = world_make_id(w, c->id_b);
-    e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
-    if (d->m.count > 0) {
-        vec3 p = d->m.points[0].point;
-        e.point.x = p.x; e.point.y = p.y; e.point.z = p.z;
-    }
-    if (world_push_event(w, &e)) world_set_last_event_contact(w, contact_index);
 }
 
 /* B's frame expressed in A's. */
@@ -257,17 +241,6 @@ static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, do
     return any;
 }
 
-void world_set_last_event_contact(carom_world *w, int contact_index)
-{
-    event_buffer *e = &w->events;
-    if (e->count == 0) return;
-    const contact *c = &w->contacts.items[contact_index];
-    int a = w->bodies.ids[c->id_a].slot, b = w->bodies.ids[c->id_b].slot;
-    if (a < 0 || b < 0) return;
-    compound_sub_children(&w->bodies.shapes[a], &w->bodies.shapes[b], c->sub, &e->children[e->count - 1][0],
-                          &e->children[e->count - 1][1]);
-}
-
 /* Wakes a sleeping body during the collision stage; its later pairs read
  * this step's frame and bounds like every awake body's. */
 static void wake_for_step(carom_world *w, int slot)
@@ -311,7 +284,7 @@ int world_collide(carom_world *w, const step_context *ctx)
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
-            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, i, CAROM_EVENT_END);
+            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
@@ -342,7 +315,7 @@ int world_collide(carom_world *w, const step_context *ctx)
                     int e = contact_find_sub(cs, c->id_a, c->id_b, k);
                     if (e >= 0 && cs->data[e].m.count > 0) ei = e;
                 }
-                push_touch_event(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
+                events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
             }
             if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
             i++;
@@ -382,8 +355,8 @@ int world_collide(carom_world *w, const step_context *ctx)
             if (!awake_a) wake_for_step(w, a);
             if (!awake_b) wake_for_step(w, b);
         }
-        if (touching && !was) push_touch_event(w, i, CAROM_EVENT_BEGIN);
-        else if (!touching && was) push_touch_event(w, i, CAROM_EVENT_END);
+        if (touching && !was) events_touch(w, i, CAROM_EVENT_BEGIN);
+        else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
         if (touching) sc->touching[sc->touching_count++] = i;
         i++;
     }

@@ -88,9 +88,10 @@ static double pair_contact_time(const impulse_body *bodies, const impact_body_st
     return t;
 }
 
-static void pair_init(carom_world *w, int k, const impact_body_state *st, double dt, impact_pair *ip)
+static void pair_init(carom_world *w, const contact_constraint *cc, int k, const impact_body_state *st, double dt,
+                      impact_pair *ip)
 {
-    const contact_constraint *c = &((const contact_constraint *)w->scratch.constraints)[k];
+    const contact_constraint *c = &cc[k];
     ip->con = k;
     ip->a = c->a;
     ip->b = c->b;
@@ -106,10 +107,11 @@ static void pair_init(carom_world *w, int k, const impact_body_state *st, double
 
 /* The geometry of the moment of contact t (the manifold recomputed at both
  * bodies' poses then; the manifold as found when already touching). */
-static void pair_geometry(carom_world *w, const impact_body_state *st, impact_pair *ip, double t, double dt)
+static void pair_geometry(carom_world *w, const contact_constraint *cc, const impact_body_state *st, impact_pair *ip,
+                          double t, double dt)
 {
     const body_store *bs = &w->bodies;
-    const contact_constraint *c = &((const contact_constraint *)w->scratch.constraints)[ip->con];
+    const contact_constraint *c = &cc[ip->con];
     const impulse_body *A = &w->scratch.bodies[c->a], *B = &w->scratch.bodies[c->b];
     const contact *ct = &w->contacts.items[c->contact];
     int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
@@ -140,16 +142,16 @@ static void pair_geometry(carom_world *w, const impact_body_state *st, impact_pa
 }
 
 /* One collision of pair ip at the current velocities; returns 1 if it acted. */
-static int pair_collide(carom_world *w, impact_body_state *st, impact_pair *ip, double dt)
+static int pair_collide(carom_world *w, const contact_constraint *cc, impact_body_state *st, impact_pair *ip, double dt)
 {
     impulse_body *bodies = w->scratch.bodies;
     impulse_body *A = &bodies[ip->a], *B = &bodies[ip->b];
     if (ip->count == 0) {
         /* not met yet: does it meet within the step at the velocities now? */
-        const contact_constraint *c = &((const contact_constraint *)w->scratch.constraints)[ip->con];
+        const contact_constraint *c = &cc[ip->con];
         double t = pair_contact_time(bodies, st, c, dt);
         if (t < 0.0) return 0;
-        pair_geometry(w, st, ip, t, dt);
+        pair_geometry(w, cc, st, ip, t, dt);
         if (ip->count == 0) return 0;
     }
     double tau = dmax(ip->tau, dmax(st[ip->a].tau, st[ip->b].tau));
@@ -201,19 +203,19 @@ int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, dou
 {
     step_scratch *s = &w->scratch;
     const body_store *bs = &w->bodies;
-    s->impact_bodies = 0;
+    s->impact.bodies = 0;
     int candidates = 0;
     for (int k = 0; k < ncon; k++)
         if (cc[k].restitution > 0.0 && cc[k].count > 0) candidates++;
     if (candidates == 0) return 1;
     size_t need = sizeof(impact_body_state) * (size_t)nb + sizeof(impact_pair) * (size_t)candidates;
-    if (need > s->impact_capacity) {
-        void *p = realloc(s->impact, need);
+    if (need > s->impact.capacity) {
+        void *p = realloc(s->impact.block, need);
         if (!p) return 0;
-        s->impact = p;
-        s->impact_capacity = need;
+        s->impact.block = p;
+        s->impact.capacity = need;
     }
-    impact_body_state *st = s->impact;
+    impact_body_state *st = s->impact.block;
     impact_pair *pairs = (impact_pair *)(st + nb);
     vec3 g = v3(w->def.gravity.x, w->def.gravity.y, w->def.gravity.z);
     memset(st, 0, sizeof *st * (size_t)nb);
@@ -224,7 +226,7 @@ int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, dou
     }
     int np = 0;
     for (int k = 0; k < ncon; k++)
-        if (cc[k].restitution > 0.0 && cc[k].count > 0) pair_init(w, k, st, dt, &pairs[np++]);
+        if (cc[k].restitution > 0.0 && cc[k].count > 0) pair_init(w, cc, k, st, dt, &pairs[np++]);
     /* earliest first (insertion sort: stable, few pairs) */
     for (int i = 1; i < np; i++) {
         impact_pair t = pairs[i];
@@ -234,7 +236,7 @@ int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, dou
     }
     for (int pass = 0; pass < IMPACT_MAX_PASSES; pass++) {
         int acted = 0;
-        for (int i = 0; i < np; i++) acted += pair_collide(w, st, &pairs[i], dt);
+        for (int i = 0; i < np; i++) acted += pair_collide(w, cc, st, &pairs[i], dt);
         if (!acted) break;
     }
     for (int i = 0; i < np; i++) {
@@ -243,7 +245,7 @@ int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, dou
         p->total_normal_impulse += pairs[i].impulse;
         if (pairs[i].impulse > p->max_normal_impulse) p->max_normal_impulse = pairs[i].impulse;
     }
-    s->impact_bodies = nb;
+    s->impact.bodies = nb;
     return 1;
 }
 
@@ -251,8 +253,8 @@ void impact_finish(carom_world *w, int nb)
 {
     step_scratch *s = &w->scratch;
     body_store *bs = &w->bodies;
-    if (s->impact_bodies != nb || nb == 0) return;
-    const impact_body_state *st = s->impact;
+    if (s->impact.bodies != nb || nb == 0) return;
+    const impact_body_state *st = s->impact.block;
     for (int b = 1; b < nb; b++) {
         if (st[b].tau <= 0.0) continue;
         int slot = s->body_slot[b];
@@ -270,5 +272,12 @@ void impact_finish(carom_world *w, int nb)
             s->delta_rotation[b] = v3_add(s->delta_rotation[b], dq);
         }
     }
-    s->impact_bodies = 0;
+    s->impact.bodies = 0;
+}
+
+void impact_memory_free(impact_memory *m)
+{
+    free(m->block);
+    m->block = NULL;
+    m->capacity = 0;
 }

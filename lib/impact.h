@@ -13,6 +13,14 @@
  * propagation model), so momentum passes through chains and racks. Records
  * what each body travelled before its impact for impact_finish. Returns 0 on
  * out of memory (nothing was changed). */
+/* impact.c's memory, kept between steps in the world's scratch. */
+typedef struct impact_memory {
+    void *block;                 /* per-body states, then the pairs */
+    size_t capacity;
+    int bodies;                  /* solver bodies impact_resolve recorded, 0: none */
+} impact_memory;
+void impact_memory_free(impact_memory *m);
+
 int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, double dt);
 /* After the sub-steps: each body that bounced travelled the whole step with
  * its post-impact velocity; correct it by what it travelled before the

@@ -34,6 +34,7 @@
 #include "penalty.h"
 #include "rotation.h"
 #include "impact.h"
+#include "events.h"
 
 /* Below this many manifolds the wide passes gain nothing (mostly empty
  * lanes), and the scalar order converges faster on a small stack: colours
@@ -220,8 +221,8 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
                        sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
-    if (!array_reserve(&s->constraints, &s->constraint_capacity, (int)con_bytes, 1)) return 0;
-    contact_constraint *cc = s->constraints;
+    if (!array_reserve(&s->solver.block, &s->solver.block_capacity, (int)con_bytes, 1)) return 0;
+    contact_constraint *cc = s->solver.block;
     constraint_point *point_pool = (constraint_point *)(cc + ncon);
     work->shock_order = (int *)(point_pool + npoints);
     work->level = work->shock_order + ncon;
@@ -266,7 +267,7 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     work->scalar = NULL;
     work->scalar_count = ctx->constraint_count;
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
-    work->wide = wide_plan(&s->wide, &s->wide_capacity, ctx->constraints, ctx->constraint_count, ctx->body_count);
+    work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count, ctx->body_count);
     if (!work->wide) return 0;
     work->scalar_count = wide_overflow(work->wide, &work->scalar);
     return 1;
@@ -440,11 +441,8 @@ static void store_impulses(carom_world *w, const step_context *ctx)
 
 static void raise_hit_events(carom_world *w, const step_context *ctx)
 {
-    const contact_set *cs = &w->contacts;
     for (int c = 0; c < ctx->constraint_count; c++) {
         const contact_constraint *con = &ctx->constraints[c];
-        const contact *ct = &cs->items[con->contact];
-        const contact_data *cd = &cs->data[con->contact];
         double approach = 0.0, total = 0.0, tangent = 0.0;
         int deepest = 0;
         for (int j = 0; j < con->count; j++) {
@@ -458,19 +456,7 @@ static void raise_hit_events(carom_world *w, const step_context *ctx)
             tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) *
                        ctx->substeps;
         }
-        carom_contact_event e;
-        memset(&e, 0, sizeof e);
-        e.type = CAROM_EVENT_HIT;
-        e.a = world_make_id(w, ct->id_a);
-        e.b = world_make_id(w, ct->id_b);
-        vec3 pt = cd->m.points[deepest].point;
-        e.point.x = pt.x; e.point.y = pt.y; e.point.z = pt.z;
-        e.normal.x = con->n.x; e.normal.y = con->n.y; e.normal.z = con->n.z;
-        e.normal_impulse = total;
-        e.tangent_impulse = tangent;
-        e.approach_speed = approach;
-        e.average_force = impulse_average_force(total, ctx->dt);
-        if (world_push_event(w, &e)) world_set_last_event_contact(w, con->contact);
+        events_hit(w, con->contact, deepest, total, tangent, approach, ctx->dt);
     }
 }
 
@@ -539,6 +525,13 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
     w->stats.contact_points = work->points;
     w->stats.pairs = w->contacts.count;
     w->stats.max_penetration = work->max_penetration;
+}
+
+void solver_memory_free(solver_memory *m)
+{
+    free(m->block);
+    free(m->wide);
+    memset(m, 0, sizeof *m);
 }
 
 int world_solve(carom_world *w, step_context *ctx)

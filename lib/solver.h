@@ -5,6 +5,15 @@
 
 #include "step.h"
 
+/* The solver's memory, kept between steps in the world's scratch. */
+typedef struct solver_memory {
+    void *block;                 /* constraints, their points, shock and contact lists */
+    int block_capacity;
+    void *wide;                  /* solver_wide.c's batches */
+    size_t wide_capacity;
+} solver_memory;
+void solver_memory_free(solver_memory *m);
+
 /* Fills ctx's solver bodies and constraints, solves, writes the bodies back
  * and raises hit events. 0 on out of memory; -1 when the settings cannot be
  * integrated (the world's error says why; no body moved). */

@@ -32,19 +32,6 @@ CAROM_API const char *carom_status_string(carom_status status)
     return "unknown status";
 }
 
-carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
-{
-    if (w) {
-        /* The message buffer is diagnostic state, not simulation state: const
-         * getters may record why they failed. */
-        carom_world *mw = (carom_world *)(uintptr_t)w;
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(mw->error, sizeof mw->error, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
 
 CAROM_API const char *carom_world_last_error(const carom_world *world)
 {
@@ -196,8 +183,10 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(w->events.children);
     step_scratch *s = &w->scratch;
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
-    free(s->constraints); free(s->island_parent); free(s->deferred_destroy);
-    free(s->tight_box); free(s->pose); free(s->touching); free(s->wide); free(s->impact);
+    solver_memory_free(&s->solver);
+    impact_memory_free(&s->impact);
+    free(s->island_parent); free(s->deferred_destroy);
+    free(s->tight_box); free(s->pose); free(s->touching);
     free(s->new_pairs);
     free(w);
 }
@@ -230,15 +219,6 @@ CAROM_API carom_status carom_world_get_def(const carom_world *w, carom_world_def
 
 CAROM_API int carom_world_body_count(const carom_world *w) { return w ? w->bodies.count : 0; }
 
-int world_push_event(carom_world *w, const carom_contact_event *e)
-{
-    event_buffer *b = &w->events;
-    if (!array_reserve((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
-    if (!array_reserve((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
-    b->children[b->count][0] = b->children[b->count][1] = -1;
-    b->items[b->count++] = *e;
-    return 1;
-}
 
 CAROM_API carom_status carom_world_get_event_children(const carom_world *w, int index, int *child_a, int *child_b)
 {
@@ -284,8 +264,7 @@ static void run_deferred_destroys(carom_world *w)
     step_scratch *s = &w->scratch;
     for (int i = 0; i < s->deferred_count; i++) {
         int id = s->deferred_destroy[i];
-        carom_body_id bid = world_make_id(w, id);
-        if (carom_body_is_valid(w, bid)) carom_body_destroy(w, bid);
+        if (w->bodies.ids[id].slot >= 0) world_destroy_body(w, id);
     }
     s->deferred_count = 0;
 }

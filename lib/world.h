@@ -9,6 +9,8 @@
 #include "contact.h"
 #include "impulse.h"
 #include "step.h"
+#include "solver.h"
+#include "impact.h"
 
 #define WORLD_ERROR_SIZE 256
 /* Fat AABB margin (m): a body moves this far before its proxy is re-inserted. */
@@ -28,10 +30,7 @@ typedef struct step_scratch {
     vec3 *delta_rotation;       /* accumulated rotation vector (small-angle) */
     int *body_slot;             /* solver body -> store slot */
     int body_capacity;
-    void *constraints;          /* solver.c's constraint arrays */
-    int constraint_capacity;
-    void *wide;                 /* solver_wide.c's batches */
-    size_t wide_capacity;
+    solver_memory solver;       /* solver.c's constraints and batches */
     int *island_parent;         /* union-find over id indices */
     int island_capacity;
     aabb *tight_box;            /* per store slot, awake dynamic/kinematic bodies: this step's bounds */
@@ -39,9 +38,7 @@ typedef struct step_scratch {
     int slot_capacity;
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;
-    void *impact;               /* impact.c's per-body states and pairs */
-    size_t impact_capacity;
-    int impact_bodies;          /* solver bodies impact_resolve recorded, 0: none */
+    impact_memory impact;       /* impact.c's per-body states and pairs */
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
     uint64_t *new_pairs;        /* pairs the broadphase found this step, sorted before they are added */
@@ -61,22 +58,6 @@ struct carom_world {
     char error[WORLD_ERROR_SIZE];
 };
 
-/* Records a formatted error on the world; returns status for chaining. */
-carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-/* Fattened bounds used by the broadphase for a body at its current pose. */
-aabb world_body_fat_aabb(const carom_world *w, int slot, double margin);
-/* Wakes the body (and, through contacts, its island on the next step). */
-void world_wake_body(carom_world *w, int slot);
-/* Removes every contact of a body (id index), emitting end events. */
-void world_remove_body_contacts(carom_world *w, int id_index);
-int world_push_event(carom_world *w, const carom_contact_event *e);
-/* Names the compound children of the last pushed event from the contact it came from (collision.c). */
-void world_set_last_event_contact(carom_world *w, int contact_index);
-carom_body_id world_make_id(const carom_world *w, int id_index);
 
 /* Stages of the step, one file each; the solver's is in solver.h. */
 int world_update_pairs(carom_world *w, const step_context *ctx);  /* collision.c (0 on out of memory) */
@@ -84,5 +65,7 @@ int world_collide(carom_world *w, const step_context *ctx);       /* collision.c
 void world_remove_ghost_contacts(carom_world *w);                 /* ghost.c: drops contacts on seams between static bodies */
 void world_update_sleep(carom_world *w, const step_context *ctx); /* island.c */
 void world_continuous(carom_world *w, const step_context *ctx);   /* toi.c */
+
+#include "world_state.h"
 
 #endif

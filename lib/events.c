@@ -1,0 +1,60 @@
+/* events.c - builds the step's contact events into the world's buffer, each
+ * with the compound children its contact names. */
+#include <string.h>
+#include "array.h"
+#include "world.h"
+#include "events.h"
+
+static int push_event(carom_world *w, const carom_contact_event *e, int contact_index)
+{
+    event_buffer *b = &w->events;
+    if (!array_reserve((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
+    if (!array_reserve((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
+    int *children = b->children[b->count];
+    children[0] = children[1] = -1;
+    b->items[b->count++] = *e;
+    const contact *c = &w->contacts.items[contact_index];
+    int sa = w->bodies.ids[c->id_a].slot, sb = w->bodies.ids[c->id_b].slot;
+    if (sa >= 0 && sb >= 0)
+        compound_sub_children(&w->bodies.shapes[sa], &w->bodies.shapes[sb], c->sub, &children[0], &children[1]);
+    return 1;
+}
+
+static void event_pair(carom_world *w, const contact *c, carom_contact_event *e, carom_event_type type)
+{
+    memset(e, 0, sizeof *e);
+    e->type = type;
+    e->a = world_make_id(w, c->id_a);
+    e->b = world_make_id(w, c->id_b);
+}
+
+int events_touch(carom_world *w, int contact_index, carom_event_type type)
+{
+    const contact *c = &w->contacts.items[contact_index];
+    const contact_data *d = &w->contacts.data[contact_index];
+    carom_contact_event e;
+    event_pair(w, c, &e, type);
+    e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
+    if (d->m.count > 0) {
+        vec3 p = d->m.points[0].point;
+        e.point.x = p.x; e.point.y = p.y; e.point.z = p.z;
+    }
+    return push_event(w, &e, contact_index);
+}
+
+int events_hit(carom_world *w, int contact_index, int point, double normal_impulse, double tangent_impulse,
+               double approach_speed, double dt)
+{
+    const contact *c = &w->contacts.items[contact_index];
+    const contact_data *d = &w->contacts.data[contact_index];
+    carom_contact_event e;
+    event_pair(w, c, &e, CAROM_EVENT_HIT);
+    vec3 pt = d->m.points[point].point;
+    e.point.x = pt.x; e.point.y = pt.y; e.point.z = pt.z;
+    e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
+    e.normal_impulse = normal_impulse;
+    e.tangent_impulse = tangent_impulse;
+    e.approach_speed = approach_speed;
+    e.average_force = impulse_average_force(normal_impulse, dt);
+    return push_event(w, &e, contact_index);
+}

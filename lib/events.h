@@ -1,0 +1,18 @@
+/* events.h - the contact events of a step, built here and nowhere else: the
+ * collision stage reports touches, the solver impacts. */
+#ifndef CAROM_EVENTS_H
+#define CAROM_EVENTS_H
+
+#include "carom/carom.h"
+#include "vecmath.h"
+
+/* A begin or end event for contact contact_index (its first point, its
+ * normal). 0 on out of memory (the event is dropped). */
+int events_touch(carom_world *w, int contact_index, carom_event_type type);
+/* A hit event for contact contact_index: at its point `point` along the
+ * manifold normal, with the step's normal and friction impulse magnitudes
+ * and the approach speed; average force over dt. */
+int events_hit(carom_world *w, int contact_index, int point, double normal_impulse, double tangent_impulse,
+               double approach_speed, double dt);
+
+#endif
