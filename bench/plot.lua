@@ -1,6 +1,11 @@
--- plot.lua - error against cost per scene from sweep.csv, as SVG, with the
--- Pareto front (no other point is both faster and more accurate) marked.
+-- plot.lua - error against cost per scene from sweep.csv, with the Pareto
+-- front (no other point is both faster and more accurate) and the three
+-- presets marked; drawn by gnuplot as outdir/pareto_<scene>.png and .svg.
 -- Usage: lua5.4 bench/plot.lua sweep.csv outdir [scene ...]
+local here = arg[0]:match("^(.*)/[^/]*$") or "."
+package.path = here .. "/?.lua;" .. package.path
+local chart = require "chart"
+
 local csv_path, outdir = arg[1], arg[2]
 assert(csv_path and outdir, "usage: lua5.4 plot.lua sweep.csv outdir [scene ...]")
 local wanted = {}
@@ -18,10 +23,40 @@ for line in io.lines(csv_path) do
   end
 end
 
+-- what each knob's value means, in words
+local knob_words = {
+  relax = { off = "no relax iterations" },
+  correction = { baumgarte = "Baumgarte correction", none = "no position correction" },
+  warm_start = { off = "no warm starting" },
+  model = { penalty_implicit = "penalty springs, implicit", penalty_explicit = "penalty springs, explicit" },
+  ccd = { off = "no continuous collision" },
+  shock = { off = "no shock propagation" },
+  friction = { off = "no friction" },
+  sleep = { on = "sleeping on" },
+  reuse = { ["0"] = "no contact reuse", ["1mm"] = "contact reuse 1 mm" },
+}
 local function label(r)
-  if r.knob == "grid" then return r.value end
-  return r.knob .. "=" .. r.value
+  if r.knob == "grid" then
+    return string.format("%s substep%s, %s iteration%s", r.substeps, r.substeps == "1" and "" or "s",
+                         r.iterations, r.iterations == "1" and "" or "s")
+  end
+  if r.knob == "preset" then return "preset " .. r.value end
+  return knob_words[r.knob] and knob_words[r.knob][r.value] or (r.knob .. " " .. r.value)
 end
+
+-- the error metrics, with their units
+local error_words = {
+  max_disp_m = "largest displacement of a box (m)",
+  max_pen_m = "deepest penetration after 10 s (m)",
+  heavy_err_m = "height error of the heavy box (m)",
+  tunneled = "the bullet went through the wall",
+  restitution_rel_err = "bounce height, relative error",
+  stop_dist_rel_err = "stopping distance, relative error",
+  accel_rel_err = "acceleration down the slope, relative error",
+  roll_speed_rel_err = "rolling speed, relative error",
+  cradle_speed_rel_err = "speed of the last ball, relative error",
+  energy_drift_rel = "energy drift over the run, relative",
+}
 
 local function pareto(points)
   local front = {}
@@ -38,7 +73,23 @@ local function pareto(points)
   return front
 end
 
-local function esc(s) return (s:gsub("&", "&amp;"):gsub("<", "&lt;")) end
+-- The default settings: the preset row if the sweep has one, else the grid
+-- point with the same solver columns as the one-knob-off-default rows.
+local function find_default(pts)
+  for _, p in ipairs(pts) do if p.knob == "preset" and p.value == "default" then return p end end
+  local ref
+  for _, p in ipairs(pts) do if p.knob == "sleep" or p.knob == "reuse" then ref = p; break end end
+  if not ref then return nil end
+  for _, p in ipairs(pts) do
+    if p.knob == "grid" then
+      local same = true
+      for _, k in ipairs{ "substeps", "iterations", "relax", "correction", "warm", "model", "ccd", "friction" } do
+        if p[k] ~= ref[k] then same = false end
+      end
+      if same then return p end
+    end
+  end
+end
 
 local by_scene, order = {}, {}
 for _, r in ipairs(rows) do
@@ -50,51 +101,78 @@ for _, scene in ipairs(order) do
   if next(wanted) == nil or wanted[scene] then
     local pts = by_scene[scene]
     local front = pareto(pts)
-    local W, H, L, R, T, B = 760, 480, 80, 20, 40, 60
+    local default = find_default(pts)
+    local presets = {}
+    for _, p in ipairs(pts) do if p.knob == "preset" then presets[p.value] = p end end
+    presets.default = presets.default or default
+    local binary = pts[1].error_name == "tunneled"
+    -- exact answers (error 0) sit on the bottom edge of a log axis, at `floor`
+    local positive = math.huge
+    for _, p in ipairs(pts) do if p.error > 0 then positive = math.min(positive, p.error) end end
+    local floor = positive < math.huge and positive / 10 or 1e-6
+    local function Y(p) return binary and p.error or math.max(p.error, floor) end
     local xmin, xmax, ymin, ymax = math.huge, -math.huge, math.huge, -math.huge
-    local floor = 1e-6
     for _, p in ipairs(pts) do
-      local y = math.max(p.error, floor)
+      local y = Y(p)
       xmin, xmax = math.min(xmin, p.ms_step), math.max(xmax, p.ms_step)
       ymin, ymax = math.min(ymin, y), math.max(ymax, y)
     end
-    local lx0, lx1 = math.log(xmin * 0.8, 10), math.log(xmax * 1.25, 10)
-    local ly0, ly1 = math.log(ymin * 0.5, 10), math.log(ymax * 2, 10)
-    if ly1 - ly0 < 1 then ly0 = ly0 - 0.5; ly1 = ly1 + 0.5 end
-    local function X(v) return L + (math.log(v, 10) - lx0) / (lx1 - lx0) * (W - L - R) end
-    local function Y(v) return H - B - (math.log(math.max(v, floor), 10) - ly0) / (ly1 - ly0) * (H - T - B) end
-    local out = {}
-    local function w(s) out[#out + 1] = s end
-    w(('<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" font-size="11">'):format(W, H))
-    w(('<rect width="%d" height="%d" fill="white"/>'):format(W, H))
-    w(('<text x="%d" y="22" font-size="15">%s: error (%s) against cost, Pareto front in red</text>'):format(L, esc(scene), esc(pts[1].error_name)))
-    w(('<rect x="%d" y="%d" width="%d" height="%d" fill="none" stroke="#444"/>'):format(L, T, W - L - R, H - T - B))
-    for e = math.ceil(lx0), math.floor(lx1) do
-      local x = X(10 ^ e)
-      w(('<line x1="%.1f" y1="%d" x2="%.1f" y2="%d" stroke="#ddd"/><text x="%.1f" y="%d" text-anchor="middle">%g</text>'):format(x, T, x, H - B, x, H - B + 16, 10 ^ e))
-    end
-    for e = math.ceil(ly0), math.floor(ly1) do
-      local y = Y(10 ^ e)
-      w(('<line x1="%d" y1="%.1f" x2="%d" y2="%.1f" stroke="#ddd"/><text x="%d" y="%.1f" text-anchor="end">%g</text>'):format(L, y, W - R, y, L - 6, y + 4, 10 ^ e))
-    end
-    w(('<text x="%d" y="%d" text-anchor="middle">ms per step (median, log scale)</text>'):format((W + L) // 2, H - 20))
-    w(('<text x="16" y="%d" transform="rotate(-90 16 %d)" text-anchor="middle">%s (log scale; %g = exact)</text>'):format((H) // 2, H // 2, esc(pts[1].error_name), floor))
-    local path = {}
-    for i, p in ipairs(front) do path[#path + 1] = (i == 1 and "M" or "L") .. ("%.1f,%.1f"):format(X(p.ms_step), Y(p.error)) end
-    w(('<path d="%s" fill="none" stroke="#c00" stroke-width="2"/>'):format(table.concat(path, " ")))
-    for _, p in ipairs(pts) do
-      local x, y = X(p.ms_step), Y(p.error)
-      w(('<circle cx="%.1f" cy="%.1f" r="%d" fill="%s"/>'):format(x, y, p.front and 5 or 3, p.front and "#c00" or "#357"))
-      if p.front or p.knob == "preset" then
-        w(('<text x="%.1f" y="%.1f" fill="%s">%s</text>'):format(x + 6, y - 4, p.front and "#900" or "#357", esc(label(p))))
+    xmin = math.max(xmin, 1e-4)
+    local x = { lo = xmin / 1.6, hi = xmax * 1.6, log = true, title = "ms per step (median wall time, log scale)" }
+    x.ticks = chart.log_ticks(x.lo, x.hi)
+    local y
+    if binary then
+      y = { lo = -0.25, hi = 1.25, ticks = { 0, 1 }, names = { [0] = "no", [1] = "yes" }, title = error_words.tunneled }
+    else
+      y = { lo = ymin / 3, hi = ymax * 3, log = true,
+            title = (error_words[pts[1].error_name] or pts[1].error_name) .. ", log scale" }
+      y.ticks = chart.log_ticks(y.lo, y.hi)
+      if positive == math.huge or ymin <= floor then
+        y.names = {}
+        y.ticks[#y.ticks + 1] = floor
+        table.sort(y.ticks)
+        y.names[floor] = "exact"
       end
     end
-    w("</svg>")
-    local f = assert(io.open(outdir .. "/pareto_" .. scene .. ".svg", "w"))
-    f:write(table.concat(out, "\n"), "\n")
-    f:close()
+    local function xy(list)
+      local out = {}
+      for _, p in ipairs(list) do out[#out + 1] = { math.max(p.ms_step, xmin), Y(p) } end
+      return out
+    end
+    local series = {
+      { name = "other settings", points = xy(pts), style = "with points pt 7 ps 0.6 lc rgb '#6f8fb0'" },
+      { name = "Pareto front", points = xy(front), lines = true, style = "with linespoints lw 2 pt 7 ps 1.0 lc rgb '#cc0000'" },
+    }
+    local marks = {
+      { "fast", "pt 9 ps 2.2 lc rgb '#e08000'" }, { "default", "pt 5 ps 1.8 lc rgb '#008a3e'" },
+      { "accurate", "pt 13 ps 2.2 lc rgb '#6a2ca0'" },
+    }
+    for _, m in ipairs(marks) do
+      local p = presets[m[1]]
+      if p then series[#series + 1] = { name = "preset " .. m[1], points = xy{ p }, style = "with points " .. m[2] } end
+    end
+    local labels, seen = {}, {}
+    for _, p in ipairs(front) do
+      local text = label(p)
+      if p == default then text = text .. " (default)" end
+      labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), text = text, color = "#990000" }
+      seen[p] = true
+    end
+    for _, m in ipairs(marks) do
+      local p = presets[m[1]]
+      if p and not seen[p] then
+        local text = p.knob == "preset" and label(p) or label(p) .. " (default)"
+        labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), text = text, color = "#333333" }
+      end
+    end
+    local unplaced = chart.render({
+      title = string.format("%s: error against cost, %d settings", scene, #pts),
+      x = x, y = y, series = series, labels = labels,
+    }, outdir .. "/pareto_" .. scene)
     io.write(("%s: %d points, front:"):format(scene, #pts))
     for _, p in ipairs(front) do io.write((" %s (%.3f ms, %.3g)"):format(label(p), p.ms_step, p.error)) end
+    if default then io.write((" | default: %s (%.3f ms, %.3g)"):format(label(default), default.ms_step, default.error)) end
+    if #unplaced > 0 then io.write((" | %d labels listed beside the plot"):format(#unplaced)) end
     io.write("\n")
   end
 end

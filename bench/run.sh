@@ -1,6 +1,8 @@
 #!/bin/sh
 # make bench: carom beside ODE and Bullet on the canonical scenes (same run,
-# interleaved), then the broadphase scaling benchmark. Results go to bench/out/.
+# interleaved), broadphase pair finding, the speed/accuracy sweep with its
+# Pareto plots, the scaling pile, narrowphase costs and the envelope at each
+# preset. Results go to bench/out/; each phase prints the time it started.
 # --quick (make bench-quick): only the canonical scenes, one round.
 set -eu
 cd "$(dirname "$0")"
@@ -8,15 +10,25 @@ mkdir -p out
 quick=0
 [ "${1:-}" != --quick ] || { quick=1; RUNS=1; }
 RUNS=${RUNS:-3}
-if ! pkg-config --exists ode bullet 2>/dev/null; then
+start=$(date +%s)
+elapsed() { s=$(($(date +%s) - start)); printf '%d:%02d' $((s / 60)) $((s % 60)); }
+phase() { echo; echo "== [$(elapsed)] $*"; }
+
+# the peers and the plotter are Debian packages (installed as root, like make deps)
+need=""
+pkg-config --exists ode bullet 2>/dev/null || need="libode-dev libbullet-dev g++"
+[ "$quick" = 1 ] || command -v gnuplot >/dev/null 2>&1 || need="$need gnuplot-nox"
+if [ -n "$need" ]; then
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "bench: installing the peers (libode-dev libbullet-dev)" >&2
-        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libode-dev libbullet-dev g++ >/dev/null
+        echo "bench: installing $need" >&2
+        # shellcheck disable=SC2086
+        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $need >/dev/null
     else
-        echo "bench: ODE/Bullet not installed (apt-get install libode-dev libbullet-dev); peers skipped" >&2
+        echo "bench: missing $need (apt-get install -y $need): peers or plots are skipped" >&2
     fi
 fi
-echo "== canonical scenes: carom vs ODE vs Bullet (RUNS=$RUNS, median ms/step)"
+
+phase "canonical scenes: carom vs ODE vs Bullet (RUNS=$RUNS, median ms/step)"
 if pkg-config --exists ode bullet 2>/dev/null; then
     make -s -C peers all
 else
@@ -24,29 +36,40 @@ else
 fi
 if [ "$quick" = 1 ]; then
     RUNS=1 ./peers/run.sh | tee out/peers_quick.txt
-    echo "bench-quick: bench/out/peers_quick.txt (one round; make bench for 3 rounds and the rest)"
+    echo "bench-quick: bench/out/peers_quick.txt in $(elapsed) (one round; make bench for 3 rounds and the rest)"
     exit 0
 fi
 RUNS=$RUNS ./peers/run.sh | tee out/peers.txt
 cp peers/build/raw.txt out/peers_raw.txt
-echo
-echo "== broadphase pair finding"
+
+phase "broadphase pair finding"
 ../build/bench/bench_broadphase | tee out/broadphase.txt
-echo
-echo "== speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
-../build/bench/sweep --runs 3 > out/sweep.csv
-lua5.4 plot.lua out/sweep.csv out | tee out/pareto.txt
-echo
-echo "== scaling: pile of 100 to 50,000 bodies"
+
+phase "speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
+# progress: one line per scene as its first row arrives
+../build/bench/sweep --runs 3 | tee out/sweep.csv | awk -F, -v t0="$start" '
+    NR > 1 && $1 != scene { scene = $1; "date +%s" | getline now; close("date +%s")
+        s = now - t0; printf "sweep: [%d:%02d] %s\n", s / 60, s % 60, scene }
+    NR > 1 { rows++ } END { printf "sweep: %d rows\n", rows }' >&2
+if command -v gnuplot >/dev/null 2>&1; then
+    lua5.4 plot.lua out/sweep.csv out | tee out/pareto.txt
+else
+    echo "bench: no gnuplot: plots skipped (apt-get install gnuplot-nox)"
+fi
+
+phase "scaling: pile of 100 to 50,000 bodies"
 ../build/bench/scaling | tee out/scaling.csv
-lua5.4 plot_scaling.lua out/scaling.csv out/scaling.svg
-echo
-echo "bench: results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto_*.svg, scaling.svg)"
-echo
-echo "== narrowphase cost per pair type"
+if command -v gnuplot >/dev/null 2>&1; then lua5.4 plot_scaling.lua out/scaling.csv out/scaling; fi
+
+phase "narrowphase cost per pair type"
 ../build/bench/bench_narrowphase | tee out/narrowphase.txt
-echo
-echo "== the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
+
+phase "the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
 ../build/bench/extremes 1000000 | tee out/extremes.txt
-echo "== snapshots: a settled pile of 10,000 bodies"
+
+phase "snapshots: a settled pile of 10,000 bodies"
 ../build/bench/snapshot | tee out/snapshot.txt
+
+echo
+echo "bench: done in $(elapsed); results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto.txt," \
+     "pareto_*.png/.svg, scaling.csv, scaling.png/.svg, narrowphase.txt, extremes.txt, snapshot.txt)"
