@@ -67,6 +67,9 @@ phase "narrowphase cost per pair type"
 phase "the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
 ../build/bench/extremes 1000000 | tee out/extremes.txt
 
+phase "level geometry: 1,000 mixed bodies on a 100,352-triangle mesh and a 316 x 316 height field"
+../build/bench/terrain | tee out/terrain.txt
+
 phase "snapshots: a settled pile of 10,000 bodies"
 ../build/bench/snapshot | tee out/snapshot.txt
 
