@@ -6,7 +6,6 @@
 #include <string.h>
 #include "array.h"
 #include "world.h"
-#include "narrowphase.h"
 #include "ranges.h"
 #include "mesh.h"
 

@@ -5,6 +5,7 @@
 #include <string.h>
 #include "array.h"
 #include "world.h"
+#include "collision.h"
 #include "events.h"
 
 /* The broadphase reports pairs in the order its trees hold them, which

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "ghost.h"
 #include "manifold.h"
 #include "mesh.h"
 

@@ -4,6 +4,7 @@
  * island with any restless body is awake as a whole. */
 #include <stdlib.h>
 #include "world.h"
+#include "island.h"
 
 static int find_root(int *parent, int i)
 {

@@ -10,6 +10,10 @@
 #define POLY_MAX_FV HULL_MAX_FACE_VERTICES
 #define CYL_SIDES 16
 
+/* Reduces up to n candidate points to at most 4 (deepest first, then the
+ * largest area), in place; returns the new count. */
+int manifold_reduce(manifold_point *pts, int n, vec3 normal);
+
 /* A convex polytope in world space (narrowphase.c builds them from shapes). */
 typedef struct poly {
     int nv, nf, ne;

@@ -8,10 +8,6 @@
 #include "shape.h"
 
 #define MANIFOLD_MAX_POINTS 4
-/* Hulls the narrowphase can hold on its stack (body creation rejects larger ones). */
-#define HULL_MAX_VERTICES 256
-#define HULL_MAX_FACES 256
-#define HULL_MAX_FACE_VERTICES 1024
 
 typedef struct manifold_point {
     vec3 point;          /* world point, midway between the two surfaces */
@@ -68,9 +64,5 @@ void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *ch
 /* The mixed material of that contact: a compound child's own, else the body's. */
 void compound_sub_material(const shape *a, const shape *b, uint32_t sub, double body_friction_a, double body_friction_b,
                            double body_restitution_a, double body_restitution_b, double *friction, double *restitution);
-
-/* Reduces up to n candidate points to at most 4 (deepest first, then the
- * largest area), in place; returns the new count. */
-int manifold_reduce(manifold_point *pts, int n, vec3 normal);
 
 #endif

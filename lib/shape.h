@@ -4,6 +4,7 @@
 #define CAROM_SHAPE_H
 
 #include "vecmath.h"
+#include "hull.h"
 
 enum {
     SHAPE_SPHERE = 0,   /* radius, centred on the body origin */
@@ -17,27 +18,6 @@ enum {
     SHAPE_COMPOUND,     /* convex children, each with a pose and material (compound.c) */
     SHAPE_TYPE_COUNT
 };
-
-/* A hull face: a convex polygon, vertices counter-clockwise seen from outside. */
-typedef struct hull_face {
-    vec3 normal;        /* outward unit normal */
-    double offset;      /* dot(normal, x) = offset on the face plane */
-    int first;          /* index into hull.face_vertices */
-    int count;          /* number of vertices of this face */
-} hull_face;
-
-typedef struct hull {
-    int vertex_count;
-    vec3 *vertices;        /* the hull's extreme points only */
-    int face_count;
-    hull_face *faces;      /* coplanar triangles merged into polygons */
-    int *face_vertices;    /* indices into vertices, per face in order */
-    int edge_count;
-    int (*edges)[2];       /* unique edges as vertex index pairs (for SAT) */
-    vec3 centroid;         /* volume centroid in the body frame */
-    double volume;
-    mat3 unit_inertia;     /* inertia about the centroid for density 1 */
-} hull;
 
 typedef struct shape {
     int type;
@@ -93,12 +73,6 @@ aabb shape_aabb(const shape *s, xform t);
 vec3 shape_support_local(const shape *s, vec3 dir);
 /* Bounding radius about the body origin (used for continuous collision). */
 double shape_bounding_radius(const shape *s);
-/* Builds a hull from points (xyz triples). Returns NULL and writes a message to
- * err when the points are degenerate (fewer than 4, coplanar, non-finite). */
-hull *hull_build(const double *points, int count, char *err, int err_size);
-hull *hull_make_box(vec3 half_extents);
-void hull_free(hull *h);
-hull *hull_clone(const hull *h);
 /* Ray cast against a shape in its body frame: origin o, direction d (not unit),
  * t in [0, max_t]. Returns 1 and sets *t and *normal (outward) on a hit;
  * a ray starting inside the shape does not hit. */

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "world.h"
+#include "toi.h"
 
 #define TOI_MAX_ITERATIONS 40
 

@@ -8,7 +8,11 @@
 #include "array.h"
 #include "world.h"
 #include "ranges.h"
+#include "collision.h"
+#include "ghost.h"
 #include "solver.h"
+#include "toi.h"
+#include "island.h"
 
 /* "major.minor.patch" from the header's numbers, the one place the version is written */
 #define CAROM_STRINGIFY_(x) #x

@@ -59,13 +59,6 @@ struct carom_world {
 };
 
 
-/* Stages of the step, one file each; the solver's is in solver.h. */
-int world_update_pairs(carom_world *w, const step_context *ctx);  /* collision.c (0 on out of memory) */
-int world_collide(carom_world *w, const step_context *ctx);       /* collision.c: narrowphase (0: out of memory) */
-void world_remove_ghost_contacts(carom_world *w);                 /* ghost.c: drops contacts on seams between static bodies */
-void world_update_sleep(carom_world *w, const step_context *ctx); /* island.c */
-void world_continuous(carom_world *w, const step_context *ctx);   /* toi.c */
-
 #include "world_state.h"
 
 #endif

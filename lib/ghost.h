@@ -1,0 +1,10 @@
+/* ghost.h - ghost contacts (ghost.c): contacts on the seams between static
+ * bodies (mesh triangles, neighbouring boxes) dropped before the solver. */
+#ifndef CAROM_GHOST_H
+#define CAROM_GHOST_H
+
+#include "step.h"
+
+void world_remove_ghost_contacts(carom_world *w);
+
+#endif
