@@ -706,7 +706,9 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (r.failed) return NULL;
     char why[WORLD_ERROR_SIZE];
     if (carom_world_def_check(&def, why, sizeof why) != CAROM_OK) return bad(&r, "settings: %s", why), NULL;
-    if (!(last_dt >= 0 && last_dt <= RANGE_DT_MAX)) return bad(&r, "last dt %g out of range", last_dt), NULL;
+    /* written as 0 (it was the last step's dt): anything else would not
+     * snapshot back to the same bytes */
+    if (last_dt != 0.0) return bad(&r, "reserved field after the settings is %g, not 0", last_dt), NULL;
     if (steps >> 63) return bad(&r, "step count out of range"), NULL;
     /* the storage hint is kept but not acted on: the store is sized for the
      * bodies the snapshot holds, never for a number the data merely claims */
