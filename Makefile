@@ -65,6 +65,8 @@ CFLAGS_ALL = $(WARN) $(OPT) -ffp-contract=off -fPIC -fvisibility=hidden -DCAROM_
 LIB_SRC := $(wildcard lib/*.c)
 LIB_OBJ := $(patsubst lib/%.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 STATIC  := $(BUILD)/lib/libcarom.a
+# Tests and benchmarks reach internal functions: they link every object as is.
+INTERNAL := $(BUILD)/lib/libcarom_internal.a
 SHARED  := $(BUILD)/lib/$(REALNAME)
 SHARED_LINKS := $(BUILD)/lib/$(SONAME) $(BUILD)/lib/libcarom.so
 
@@ -87,7 +89,15 @@ $(BUILD)/obj/%.o: lib/%.c $(wildcard lib/*.h) $(wildcard include/carom/*.h) | $(
 $(BUILD)/obj $(BUILD)/lib $(BUILD)/tests $(BUILD)/bench $(BUILD)/lua:
 	mkdir -p $@
 
+# The installed static library exports only carom_*: the objects linked into
+# one, its hidden (internal) symbols made local, so they cannot clash with a
+# user's own when linked statically.
 $(STATIC): $(LIB_OBJ) | $(BUILD)/lib
+	ld -r -o $(BUILD)/obj/carom_all.o $^
+	objcopy --localize-hidden $(BUILD)/obj/carom_all.o
+	rm -f $@ && ar rcs $@ $(BUILD)/obj/carom_all.o
+
+$(INTERNAL): $(LIB_OBJ) | $(BUILD)/lib
 	rm -f $@ && ar rcs $@ $^
 
 $(SHARED): $(LIB_OBJ) lib/carom.map | $(BUILD)/lib
@@ -100,11 +110,11 @@ $(BUILD)/lib/libcarom.so: $(BUILD)/lib/$(SONAME)
 	ln -sf $(SONAME) $@
 
 # Tests link the static library: they reach internal (hidden) functions too.
-$(BUILD)/tests/%: tests/%.c $(STATIC) $(wildcard tests/*.h) | $(BUILD)/tests
-	$(CC) $(CFLAGS_ALL) -Wno-unused-parameter $< -o $@ $(STATIC) $(CMOCKA_LIBS) $(LDLIBS_ALL) $(SANLD)
+$(BUILD)/tests/%: tests/%.c $(INTERNAL) $(wildcard tests/*.h) | $(BUILD)/tests
+	$(CC) $(CFLAGS_ALL) -Wno-unused-parameter $< -o $@ $(INTERNAL) $(CMOCKA_LIBS) $(LDLIBS_ALL) $(SANLD)
 
-$(BUILD)/bench/%: bench/%.c $(STATIC) $(wildcard bench/*.h) | $(BUILD)/bench
-	$(CC) $(CFLAGS_ALL) -Wno-unused-function -Ibench $< -o $@ $(STATIC) $(LDLIBS_ALL) $(SANLD)
+$(BUILD)/bench/%: bench/%.c $(INTERNAL) $(wildcard bench/*.h) | $(BUILD)/bench
+	$(CC) $(CFLAGS_ALL) -Wno-unused-function -Ibench $< -o $@ $(INTERNAL) $(LDLIBS_ALL) $(SANLD)
 
 # The Lua module and the runner (the runner links the module in, so it runs
 # under the sanitizers without preloading anything into the system lua).

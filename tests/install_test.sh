@@ -52,6 +52,9 @@ check_prefix() {
     [ "$(readlink "$r$libdir/libcarom.so.$major")" = "libcarom.so.$version" ] || fail "$prefix: libcarom.so.$major link"
     [ "$(readlink "$r$libdir/libcarom.so")" = "libcarom.so.$major" ] || fail "$prefix: libcarom.so link"
     [ -f "$r$libdir/libcarom.a" ] || fail "$prefix: no libcarom.a"
+    # statically linked, only carom_* may be global (nothing to clash with a user's own symbols)
+    leaked=$(nm -g --defined-only "$r$libdir/libcarom.a" | awk 'NF == 3 && $3 !~ /^carom_/ {print $3}')
+    [ -z "$leaked" ] || fail "$prefix: libcarom.a exports non-carom symbols: $(echo $leaked | head -c 300)"
     [ -f "$r$prefix/include/carom/carom.h" ] || fail "$prefix: no include/carom/carom.h"
     pc="$r$libdir/pkgconfig/carom.pc"
     grep -qx 'Requires.private: ccd' "$pc" || fail "$prefix: carom.pc lacks Requires.private: ccd"
