@@ -283,10 +283,8 @@ end
 collectgarbage("restart")
 print(string.format("fuzz (seed %d): %d calls, %d succeeded, %d raised Lua errors", SEED, call_number, ok_calls, error_calls))
 
-local passed, failed = 0, 0
-local function check(cond, what)
-  if cond then passed = passed + 1 else failed = failed + 1; print("FAIL " .. what) end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local check = T.check
 local function finite(...)
   for i = 1, select("#", ...) do
     local v = select(i, ...)
@@ -318,5 +316,4 @@ for bi, b in ipairs(bodies) do
 end
 worlds, bodies, shapes = nil, nil, nil
 collectgarbage("collect")
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()

@@ -4,28 +4,8 @@
 -- against what the code printed. Run by `make check` as
 -- `carom-run --test tests/lua_api_test.lua`; ends with "N passed, M failed".
 local carom = require "carom"
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
-
-local function near(got, want, tol, what)
-  if type(got) ~= "number" or not (math.abs(got - want) <= tol) then
-    error(string.format("%s: got %s, expected %.12g (tolerance %g)", what or "value", tostring(got), want, tol), 2)
-  end
-end
-
--- fn(...) raises, and the message contains `text` (plain text, not a pattern)
-local function raises(text, fn, ...)
-  local ok, err = pcall(fn, ...)
-  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
-  if not tostring(err):find(text, 1, true) then
-    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
-  end
-  return tostring(err)
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test, near, raises = T.test, T.near, T.raises
 
 local G = 9.81
 local function sphere(r) return carom.sphere{ radius = r or 0.5 } end
@@ -841,5 +821,4 @@ test("the module: version, clock", function()
   assert(type(t0) == "number" and carom.clock() >= t0)
 end)
 
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()

@@ -3,20 +3,8 @@
 -- them where the geometry says, and every bad input is refused naming the
 -- field. Run by `make check` as `carom-run --test tests/mesh_test.lua`.
 local carom = require "carom"
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
-
-local function raises(text, fn, ...)
-  local ok, err = pcall(fn, ...)
-  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
-  if not tostring(err):find(text, 1, true) then
-    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
-  end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test, raises = T.test, T.raises
 
 -- an n x n grid of 1 m cells centred on the origin at z = 0
 local function grid(n)
@@ -169,5 +157,4 @@ test("compound: mass, a table standing on a mesh, the child in ray casts and eve
   raises("unknown option", carom.compound, { { shape = carom.sphere{ radius = 1 }, colour = 1 } })
 end)
 
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()

@@ -3,14 +3,10 @@
 -- dt), --steps/--seconds/--dt/--substeps, --record's CSV and --bench's lines.
 -- Runs the very binary that runs this script (arg[-1]), so `make check` tests
 -- the sanitizer build under SAN=1 too. Ends with "N passed, M failed".
-local passed, failed = 0, 0
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test = T.test
 local RUNNER = arg and arg[-1]
 assert(RUNNER and RUNNER:find("carom%-run"), "run me with carom-run --test (arg[-1] is the runner)")
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
 
 local temporaries = {}
 local function temp(contents)
@@ -237,5 +233,4 @@ print(string.format("module %%s: ball at z = %%.3f", carom.version, z))
 end)
 
 for _, name in ipairs(temporaries) do os.remove(name) end
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()

@@ -5,20 +5,8 @@
 -- truncated, corrupted and foreign strings raise a clear error.
 -- Run by `make check` as `carom-run --test tests/snapshot_test.lua`.
 local carom = require "carom"
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
-
-local function raises(text, fn, ...)
-  local ok, err = pcall(fn, ...)
-  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
-  if not tostring(err):find(text, 1, true) then
-    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
-  end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test, raises = T.test, T.raises
 
 local function mixed_scene(preset)
   local w = carom.world{ preset = preset }
@@ -116,5 +104,4 @@ test("bad snapshots raise a clear error", function()
   raises("version 7", carom.restore, s:sub(1, 8) .. "\7" .. s:sub(10))
 end)
 
-print(("%d passed, %d failed"):format(passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()
