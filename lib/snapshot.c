@@ -607,7 +607,9 @@ static int read_bodies(reader *r, carom_world *w)
         }
         if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX))
             return bad(r, "body %d moves faster than any world allows", i);
-        if (!(s->mass[i] >= 0) || (dynamic && !(v3_len(s->force[i]) / s->mass[i] <= RANGE_ACCELERATION_MAX)))
+        /* the force bound is the API's loosest (apply_force checks it against
+         * the mass then; set_mass may lower the mass later) */
+        if (!(s->mass[i] >= 0) || !(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX))
             return bad(r, "body %d mass or force out of range", i);
         if (!(s->friction[i] >= 0 && s->friction[i] <= RANGE_FRICTION_MAX && s->restitution[i] >= 0 &&
               s->restitution[i] <= 1 && s->linear_damping[i] >= 0 && s->linear_damping[i] <= RANGE_DAMPING_MAX &&
