@@ -1,7 +1,9 @@
-/* test_solver.c - the world step against analytic answers: bounce height,
+/* test_solver.c - the solver against analytic answers: bounce height,
  * stopping distance, incline statics and sliding, rolling transition, energy
- * of an elastic gas, stacks, pyramid, a 1000:1 mass ratio, a 750 m/s bullet,
- * sleeping and hit events. */
+ * of an elastic gas, stacks, pyramid, a 1000:1 mass ratio, locks, momentum,
+ * the wide passes against the scalar ones. (Collision reuse:
+ * test_collision.c; sleeping: test_island.c; continuous collision:
+ * test_toi.c.) */
 #define _POSIX_C_SOURCE 200809L /* setenv */
 #include <stdarg.h>
 #include <stdlib.h>
@@ -15,67 +17,7 @@
 #include "carom/carom.h"
 #include "world.h"
 
-#define G 9.81
-#define DT (1.0 / 60.0)
-#define PI_ 3.14159265358979323846
-
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
-
-static carom_world *world_with(carom_world_def d, int ground, double ground_mu, double ground_e)
-{
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    if (ground) {
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.shape = carom_shape_plane(0, 0, 1, 0);
-        g.friction = ground_mu;
-        g.restitution = ground_e;
-        assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
-    }
-    return w;
-}
-
-static carom_body_id add_box(carom_world *w, double x, double y, double z, double he, double mass, double mu)
-{
-    carom_body_def d = carom_body_def_default();
-    d.position = vec(x, y, z);
-    d.shape = carom_shape_box(he, he, he);
-    d.mass = mass;
-    d.friction = mu;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
-}
-
-static carom_vec3 pos(carom_world *w, carom_body_id id)
-{
-    carom_vec3 p;
-    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
-    return p;
-}
-
-static carom_vec3 vel(carom_world *w, carom_body_id id)
-{
-    carom_vec3 v;
-    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
-    return v;
-}
-
-static void step_n(carom_world *w, int n, double dt)
-{
-    for (int i = 0; i < n; i++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
-}
-
-#define EXPECT_NEAR(got, want, tol, what)                                                          \
-    do {                                                                                           \
-        double g_ = (got), w_ = (want);                                                           \
-        print_message("%s: %.6f (expected %.6f)\n", (what), g_, w_);                             \
-        if (!(fabs(g_ - w_) <= (tol))) {                                                          \
-            print_error("%s: got %.6f, expected %.6f (tolerance %.6f)\n", (what), g_, w_, (double)(tol)); \
-            fail();                                                                                \
-        }                                                                                          \
-    } while (0)
+#include "helpers.h"
 
 /* e = 0.5 from 1 m: the first rebound rises e^2 h = 0.25 m. */
 static void test_bounce_height(void **state)
@@ -310,120 +252,6 @@ static void test_mass_ratio_holds(void **state)
     carom_world_destroy(w);
 }
 
-/* The peers' bullet: 1 cm, 10 g sphere at 750 m/s against a 5 cm wall. */
-static void test_bullet_does_not_tunnel(void **state)
-{
-    (void)state;
-    carom_world *w = world_with(carom_world_def_default(), 0, 0.5, 0.0);
-    carom_body_def wall = carom_body_def_default();
-    wall.type = CAROM_BODY_STATIC;
-    wall.position = vec(1.025, 0, 2.0);
-    wall.shape = carom_shape_box(0.025, 2.0, 2.0);
-    wall.friction = 0.5;
-    carom_body_create(w, &wall);
-    carom_body_def d = carom_body_def_default();
-    d.position = vec(0, 0, 2.0);
-    d.shape = carom_shape_sphere(0.01);
-    d.mass = 0.01;
-    d.friction = 0.5;
-    d.linear_velocity = vec(750, 0, 0);
-    d.bullet = 1;
-    carom_body_id b = carom_body_create(w, &d);
-    int hits = 0;
-    for (int i = 0; i < 60; i++) {
-        step_n(w, 1, DT);
-        const carom_contact_event *ev;
-        int n = carom_world_get_events(w, &ev);
-        for (int j = 0; j < n; j++)
-            if (ev[j].type == CAROM_EVENT_HIT) {
-                hits++;
-                /* the wall stops it: J = m v, average force J / dt */
-                EXPECT_NEAR(ev[j].normal_impulse, 0.01 * 750.0, 0.01 * 7.5, "bullet impulse");
-                EXPECT_NEAR(ev[j].average_force, ev[j].normal_impulse / DT, 1e-9, "average force");
-            }
-        assert_true(pos(w, b).x < 1.0);
-    }
-    assert_int_equal(hits, 1);
-    carom_world_destroy(w);
-}
-
-/* The same without continuous collision: the fast path must be what saves it. */
-static void test_bullet_tunnels_without_ccd(void **state)
-{
-    (void)state;
-    carom_world_def wd = carom_world_def_default();
-    wd.enable_continuous = 0;
-    carom_world *w = world_with(wd, 0, 0.5, 0.0);
-    carom_body_def wall = carom_body_def_default();
-    wall.type = CAROM_BODY_STATIC;
-    wall.position = vec(1.025, 0, 2.0);
-    wall.shape = carom_shape_box(0.025, 2.0, 2.0);
-    carom_body_create(w, &wall);
-    carom_body_def d = carom_body_def_default();
-    d.position = vec(-20, 0, 2.0);
-    d.shape = carom_shape_sphere(0.01);
-    d.mass = 0.01;
-    d.linear_velocity = vec(750, 0, 0);
-    carom_body_id b = carom_body_create(w, &d);
-    step_n(w, 60, DT);
-    assert_true(pos(w, b).x > 1.05);
-    carom_world_destroy(w);
-}
-
-/* Resting boxes keep the same 4 contact features for 600 steps. */
-static void test_feature_ids_stable(void **state)
-{
-    (void)state;
-    carom_world_def wd = carom_world_def_default();
-    wd.enable_sleep = 0;
-    carom_world *w = world_with(wd, 1, 0.6, 0.0);
-    carom_body_id lower = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.6);
-    carom_body_id upper = add_box(w, 0, 0, 1.5, 0.5, 1.0, 0.6);
-    step_n(w, 5, DT);
-    int ia = (int)lower.index1 - 1, ib = (int)upper.index1 - 1;
-    int ci = contact_find(&w->contacts, ia, ib);
-    assert_true(ci >= 0);
-    uint32_t ids[4];
-    assert_int_equal(w->contacts.data[ci].m.count, 4);
-    for (int j = 0; j < 4; j++) ids[j] = w->contacts.data[ci].m.points[j].id;
-    for (int s = 0; s < 600; s++) {
-        step_n(w, 1, DT);
-        ci = contact_find(&w->contacts, ia, ib);
-        assert_true(ci >= 0);
-        const manifold *m = &w->contacts.data[ci].m;
-        assert_int_equal(m->count, 4);
-        for (int j = 0; j < 4; j++) assert_int_equal(m->points[j].id, ids[j]);
-    }
-    carom_world_destroy(w);
-}
-
-static void test_sleep_and_wake(void **state)
-{
-    (void)state;
-    carom_world *w = world_with(carom_world_def_default(), 1, 0.6, 0.0);
-    carom_body_id box = add_box(w, 0, 0, 0.5, 0.5, 1.0, 0.6);
-    step_n(w, 120, DT);
-    assert_false(carom_body_is_awake(w, box));
-    carom_world_stats st = carom_world_stats_init();
-    carom_world_get_stats(w, &st);
-    assert_int_equal(st.awake_bodies, 0);
-    /* a falling box wakes it on impact */
-    carom_body_id dropper = add_box(w, 0, 0, 3.0, 0.5, 1.0, 0.6);
-    int woke = 0;
-    for (int i = 0; i < 60; i++) {
-        step_n(w, 1, DT);
-        if (carom_body_is_awake(w, box)) woke = 1;
-    }
-    assert_true(woke);
-    EXPECT_NEAR(pos(w, dropper).z, 1.5, 0.02, "dropped box rests on the first");
-    /* setting a velocity wakes a sleeper */
-    step_n(w, 120, DT);
-    assert_false(carom_body_is_awake(w, dropper));
-    carom_body_set_linear_velocity(w, dropper, vec(0, 0, 1));
-    assert_true(carom_body_is_awake(w, dropper));
-    carom_world_destroy(w);
-}
-
 /* A particle (rotation locked) and a planar body stay within their constraints. */
 static void test_locks(void **state)
 {
@@ -589,149 +417,6 @@ static void test_wide_passes_match_scalar(void **state)
     }
 }
 
-/* A kept manifold (contact_reuse_distance) against a fresh one, every step: a
- * box turned 0.3 rad drifts, rises, tilts and spins slowly over a frictionless
- * static slab, so its manifold is kept for some steps and recomputed at others; kept
- * separations must match the narrowphase's to well under a micrometre and
- * points to the reuse distance. */
-static void test_kept_manifolds_match_fresh(void **state)
-{
-    (void)state;
-    carom_world_def wd = carom_world_def_default();
-    wd.enable_sleep = 0;
-    wd.gravity.z = 0.0; /* no load: the box rests exactly, so only the drift moves it */
-    carom_world *w = carom_world_create(&wd);
-    assert_non_null(w);
-    carom_body_def g = carom_body_def_default();
-    g.type = CAROM_BODY_STATIC;
-    g.shape = carom_shape_box(5, 5, 0.5);
-    g.position = vec(0, 0, -0.5);
-    g.friction = 0.0;
-    carom_body_create(w, &g);
-    carom_body_def d = carom_body_def_default();
-    d.shape = carom_shape_box(0.5, 0.4, 0.3);
-    d.position = vec(0, 0, 0.3); /* touching */
-    carom_quat q = {cos(0.15), 0, 0, sin(0.15)};
-    d.orientation = q;
-    d.friction = 0.0;
-    d.linear_velocity = vec(0.0005, 0.0003, 0.0002);
-    d.angular_velocity = vec(0.0005, 0, 0.002);
-    carom_body_id box = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(box));
-    int kept = 0, fresh = 0;
-    xform last_rel = {v3(1e9, 0, 0), q_identity()};
-    for (int step = 0; step < 240; step++) {
-        /* the manifold a step solves with belongs to the poses it starts from */
-        body_store *bs = &w->bodies;
-        xform pose[2] = {body_xform(bs, 0), body_xform(bs, 1)};
-        step_n(w, 1, DT);
-        /* hold the drift: the solver only pushes along the normal */
-        carom_body_set_linear_velocity(w, box, vec(0.0005, 0.0003, 0.0002));
-        carom_body_set_angular_velocity(w, box, vec(0.0005, 0, 0.002));
-        assert_int_equal(w->contacts.count, 1);
-        contact *c = &w->contacts.items[0];
-        contact_data *cd = &w->contacts.data[0];
-        assert_true(cd->m.count == 4);
-        int same = memcmp(&c->rel_pose, &last_rel, sizeof last_rel) == 0;
-        if (same) kept++; else fresh++;
-        last_rel = c->rel_pose;
-        int sa = bs->ids[c->id_a].slot, sb = bs->ids[c->id_b].slot;
-        collide_cache cache = c->cache;
-        manifold m;
-        collide(&bs->shapes[sa], pose[sa], &bs->shapes[sb], pose[sb], wd.speculative_distance, &cache, &m);
-        assert_int_equal(m.count, cd->m.count);
-        assert_true(v3_len(v3_sub(m.normal, cd->m.normal)) < 1e-9);
-        for (int i = 0; i < cd->m.count; i++) {
-            int j = 0;
-            while (j < m.count && m.points[j].id != cd->m.points[i].id) j++;
-            assert_true(j < m.count);
-            double ds = fabs(m.points[j].separation - cd->m.points[i].separation);
-            double dp = v3_len(v3_sub(m.points[j].point, cd->m.points[i].point));
-            if (!(ds < 1e-7 && dp <= wd.contact_reuse_distance)) {
-                print_error("step %d point %d: separation off by %.3g m, point by %.3g m\n", step, i, ds, dp);
-                fail();
-            }
-        }
-    }
-    print_message("manifold kept %d steps, computed %d\n", kept, fresh);
-    assert_true(kept > 120 && fresh > 20);
-    carom_world_destroy(w);
-}
-
-/* Pairs the collision stage left without a manifold (bounds apart, or known
- * apart from an earlier step and not moved enough since) must have none when
- * computed afresh: bodies of every shape drift and tumble slowly in a closed
- * room without gravity, and every step each empty pair is checked against
- * the narrowphase at the poses the step started from. */
-static void test_skipped_pairs_are_apart(void **state)
-{
-    (void)state;
-    carom_world_def wd = carom_world_def_default();
-    wd.enable_sleep = 0;
-    wd.gravity.z = 0.0;
-    carom_world *w = carom_world_create(&wd);
-    assert_non_null(w);
-    const double walls[6][4] = {{1, 0, 0, -3}, {-1, 0, 0, -3}, {0, 1, 0, -3}, {0, -1, 0, -3}, {0, 0, 1, -3}, {0, 0, -1, -3}};
-    for (int i = 0; i < 6; i++) {
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.shape = carom_shape_plane(walls[i][0], walls[i][1], walls[i][2], walls[i][3]);
-        carom_body_create(w, &g);
-    }
-    const double pts[24] = {0.3, 0, 0, -0.3, 0, 0, 0, 0.25, 0, 0, -0.25, 0, 0, 0, 0.35, 0, 0, -0.35, 0.1, 0.1, 0.1, -0.1, 0.1, -0.1};
-    uint64_t r = 0x5EEDF00DULL;
-    int n = 0;
-    for (int i = 0; i < 5; i++)
-        for (int j = 0; j < 5; j++)
-            for (int k = 0; k < 5; k++) {
-                carom_body_def d = carom_body_def_default();
-                d.position = vec(-2.0 + i, -2.0 + j, -2.0 + k);
-                switch (n % 5) {
-                case 0: d.shape = carom_shape_box(0.35, 0.25, 0.3); break;
-                case 1: d.shape = carom_shape_sphere(0.35); break;
-                case 2: d.shape = carom_shape_capsule(0.2, 0.25); break;
-                case 3: d.shape = carom_shape_cylinder(0.3, 0.25); break;
-                default: d.shape = carom_shape_hull(pts, 8); break;
-                }
-                double u[6];
-                for (int q = 0; q < 6; q++) {
-                    r = r * 6364136223846793005ULL + 1442695040888963407ULL;
-                    u[q] = (double)(r >> 11) / 9007199254740992.0 - 0.5;
-                }
-                d.linear_velocity = vec(0.6 * u[0], 0.6 * u[1], 0.6 * u[2]);
-                d.angular_velocity = vec(2 * u[3], 2 * u[4], 2 * u[5]);
-                d.restitution = 0.5;
-                assert_false(carom_body_id_is_null(carom_body_create(w, &d)));
-                n++;
-            }
-    int checked = 0, apart_kept = 0;
-    for (int step = 0; step < 600; step++) {
-        body_store *bs = &w->bodies;
-        xform pose[256];
-        assert_true(bs->count <= 256);
-        for (int i = 0; i < bs->count; i++) pose[i] = body_xform(bs, i);
-        step_n(w, 1, DT);
-        for (int i = 0; i < w->contacts.count; i++) {
-            const contact *c = &w->contacts.items[i];
-            if (c->flags & CONTACT_TOUCHING) continue;
-            int sa = bs->ids[c->id_a].slot, sb = bs->ids[c->id_b].slot;
-            collide_cache cache = c->cache;
-            manifold m;
-            collide(&bs->shapes[sa], pose[sa], &bs->shapes[sb], pose[sb], wd.speculative_distance, &cache, &m);
-            if (m.count != 0) {
-                print_error("step %d: pair %d-%d skipped but has %d points (separation %.4g)\n", step, sa, sb, m.count,
-                            m.points[0].separation);
-                fail();
-            }
-            checked++;
-            if (c->flags & CONTACT_APART) apart_kept++;
-        }
-    }
-    print_message("%d empty pairs checked, %d of them known apart\n", checked, apart_kept);
-    assert_true(apart_kept > 1000);
-    carom_world_destroy(w);
-}
-
 /* The AVX2 and SSE2 builds of the wide passes give the same bits (no FMA,
  * same operation order): a 210-box pyramid run 120 steps each way. */
 static void test_wide_kernels_agree(void **state)
@@ -861,15 +546,9 @@ int main(void)
         cmocka_unit_test(test_stack_of_ten),
         cmocka_unit_test(test_pyramid_stands),
         cmocka_unit_test(test_mass_ratio_holds),
-        cmocka_unit_test(test_bullet_does_not_tunnel),
-        cmocka_unit_test(test_bullet_tunnels_without_ccd),
-        cmocka_unit_test(test_feature_ids_stable),
-        cmocka_unit_test(test_sleep_and_wake),
         cmocka_unit_test(test_locks),
         cmocka_unit_test(test_momentum_conserved_in_free_collisions),
         cmocka_unit_test(test_wide_passes_match_scalar),
-        cmocka_unit_test(test_kept_manifolds_match_fresh),
-        cmocka_unit_test(test_skipped_pairs_are_apart),
         cmocka_unit_test(test_wide_kernels_agree),
         cmocka_unit_test(test_mass_ratio_holds_in_a_wide_step),
         cmocka_unit_test(test_resting_sag_is_the_soft_deflection),

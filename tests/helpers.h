@@ -1,0 +1,72 @@
+/* helpers.h - scene helpers the C tests share: worlds with a ground plane,
+ * boxes, positions and velocities read back (each call asserted), stepping,
+ * and EXPECT_NEAR, which prints every value it checks. Include after
+ * cmocka.h and carom/carom.h. */
+#ifndef CAROM_TEST_HELPERS_H
+#define CAROM_TEST_HELPERS_H
+
+#include <math.h>
+
+#define G 9.81
+#define DT (1.0 / 60.0)
+#define PI_ 3.14159265358979323846
+
+static inline carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
+
+static inline carom_world *world_with(carom_world_def d, int ground, double ground_mu, double ground_e)
+{
+    carom_world *w = carom_world_create(&d);
+    assert_non_null(w);
+    if (ground) {
+        carom_body_def g = carom_body_def_default();
+        g.type = CAROM_BODY_STATIC;
+        g.shape = carom_shape_plane(0, 0, 1, 0);
+        g.friction = ground_mu;
+        g.restitution = ground_e;
+        assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    }
+    return w;
+}
+
+static inline carom_body_id add_box(carom_world *w, double x, double y, double z, double he, double mass, double mu)
+{
+    carom_body_def d = carom_body_def_default();
+    d.position = vec(x, y, z);
+    d.shape = carom_shape_box(he, he, he);
+    d.mass = mass;
+    d.friction = mu;
+    carom_body_id id = carom_body_create(w, &d);
+    assert_false(carom_body_id_is_null(id));
+    return id;
+}
+
+static inline carom_vec3 pos(carom_world *w, carom_body_id id)
+{
+    carom_vec3 p;
+    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
+    return p;
+}
+
+static inline carom_vec3 vel(carom_world *w, carom_body_id id)
+{
+    carom_vec3 v;
+    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
+    return v;
+}
+
+static inline void step_n(carom_world *w, int n, double dt)
+{
+    for (int i = 0; i < n; i++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+}
+
+#define EXPECT_NEAR(got, want, tol, what)                                                          \
+    do {                                                                                           \
+        double g_ = (got), w_ = (want);                                                           \
+        print_message("%s: %.6f (expected %.6f)\n", (what), g_, w_);                             \
+        if (!(fabs(g_ - w_) <= (tol))) {                                                          \
+            print_error("%s: got %.6f, expected %.6f (tolerance %.6f)\n", (what), g_, w_, (double)(tol)); \
+            fail();                                                                                \
+        }                                                                                          \
+    } while (0)
+
+#endif
