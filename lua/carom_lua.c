@@ -20,9 +20,12 @@
 
 int clua_arg_error(lua_State *L, int arg, const char *fname, const char *fmt, ...)
 {
+    /* C's formatter, not lua_pushvfstring: range messages print doubles with %g,
+     * which Lua's own formatter does not know. */
+    char msg[512];
     va_list ap;
     va_start(ap, fmt);
-    const char *msg = lua_pushvfstring(L, fmt, ap);
+    vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     return luaL_error(L, "bad argument #%d to '%s' (%s)", arg, fname, msg);
 }
@@ -81,7 +84,7 @@ lua_Integer clua_check_integer(lua_State *L, int arg, const char *fname, lua_Int
         if (!(d == floor(d) && d >= -9e15 && d <= 9e15)) clua_arg_error(L, arg, fname, "number must be an integer");
         v = (lua_Integer)d;
     }
-    if (v < lo || v > hi) clua_arg_error(L, arg, fname, "must be in %I..%I", (LUAI_UACINT)lo, (LUAI_UACINT)hi);
+    if (v < lo || v > hi) clua_arg_error(L, arg, fname, "must be in %lld..%lld", (long long)lo, (long long)hi);
     return v;
 }
 

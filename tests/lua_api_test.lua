@@ -821,4 +821,9 @@ test("the module: version, clock", function()
   assert(type(t0) == "number" and carom.clock() >= t0)
 end)
 
+test("range errors print the offending numbers (C's %g, not Lua's formatter)", function()
+  raises("half_extents {2e+07, 1, 1}", carom.box, { half_extents = {2e7, 1, 1} })
+  raises("offset 1e+13", carom.plane, { normal = {0, 0, 1}, offset = 1e13 })
+end)
+
 T.finish()
