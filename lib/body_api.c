@@ -415,6 +415,14 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     return world_make_id(w, id_index);
 }
 
+CAROM_API carom_status carom_body_try_create(carom_world *w, const carom_body_def *def, carom_body_id *out)
+{
+    if (!out) return w ? world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_try_create: out is NULL") : CAROM_ERROR_INVALID_ARGUMENT;
+    *out = carom_body_create(w, def);
+    if (!carom_body_id_is_null(*out)) return CAROM_OK;
+    return w ? w->last_status : CAROM_ERROR_INVALID_ARGUMENT;
+}
+
 CAROM_API carom_status carom_body_destroy(carom_world *w, carom_body_id id)
 {
     GET_SLOT(w, id, "body_destroy");

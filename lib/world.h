@@ -56,6 +56,7 @@ struct carom_world {
     int locked;                 /* inside step or a callback */
     int in_callback;
     char error[WORLD_ERROR_SIZE];
+    carom_status last_status;   /* the status world_fail last recorded */
 };
 
 

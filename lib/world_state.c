@@ -15,6 +15,7 @@ carom_status world_fail(const carom_world *w, carom_status status, const char *f
         va_start(ap, fmt);
         vsnprintf(mw->error, sizeof mw->error, fmt, ap);
         va_end(ap);
+        mw->last_status = status;
     }
     return status;
 }

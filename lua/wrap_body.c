@@ -143,10 +143,9 @@ int clua_world_add_body(lua_State *L)
     clua_field_vec3(L, 2, fname, "angular_velocity", &d.angular_velocity);
     clua_field_quat(L, 2, fname, "orientation", &d.orientation);
     clua_field_vec3(L, 2, fname, "plane_normal", &d.plane_normal);
-    if (clua_field_number(L, 2, fname, "mass", &d.mass) && !(d.mass > 0))
-        clua_arg_error(L, 2, fname, "mass must be positive (leave it out to use density)");
-    if (clua_field_number(L, 2, fname, "density", &d.density) && !(d.density > 0))
-        clua_arg_error(L, 2, fname, "density must be positive");
+    /* ranges are the C library's to check (mass 0: use density) */
+    clua_field_number(L, 2, fname, "mass", &d.mass);
+    clua_field_number(L, 2, fname, "density", &d.density);
     clua_field_number(L, 2, fname, "restitution", &d.restitution);
     clua_field_number(L, 2, fname, "friction", &d.friction);
     clua_field_number(L, 2, fname, "gravity_scale", &d.gravity_scale);
@@ -172,11 +171,12 @@ int clua_world_add_body(lua_State *L)
     lua_getiuservalue(L, 1, WORLD_UV_DATA);
     if (!lua_checkstack(L, 8)) return luaL_error(L, "add_body: Lua stack overflow");
     lw = clua_check_world(L, 1, fname); /* a finalizer run by the checks above may have destroyed it */
-    carom_body_id id = carom_body_create(lw->world, &d);
-    if (carom_body_id_is_null(id)) {
+    carom_body_id id;
+    carom_status st = carom_body_try_create(lw->world, &d, &id);
+    if (st != CAROM_OK) {
         char buf[256];
         const char *msg = clua_copy_error(lw->world, buf, sizeof buf);
-        if (strstr(msg, "inside step") || strstr(msg, "locked")) return luaL_error(L, "add_body: %s", msg);
+        if (st != CAROM_ERROR_INVALID_ARGUMENT) return luaL_error(L, "add_body: %s", msg);
         return clua_arg_error(L, 2, fname, "%s", msg);
     }
     lua_pushboolean(L, 1);
@@ -276,7 +276,6 @@ static int body_set_mass(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_mass", &b);
     double m = clua_check_number(L, 2, "set_mass");
-    if (!(m > 0)) clua_arg_error(L, 2, "set_mass", "mass must be positive");
     w = check_body(L, 1, "set_mass", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_mass(w, b->id, m), 2, "set_mass");
 }
@@ -315,7 +314,6 @@ static int body_set_restitution(lua_State *L)
     clua_body *b;
     carom_world *w = check_body(L, 1, "set_restitution", &b);
     double v = clua_check_number(L, 2, "set_restitution");
-    if (!(v >= 0 && v <= 1)) clua_arg_error(L, 2, "set_restitution", "restitution must be in [0, 1]");
     w = check_body(L, 1, "set_restitution", &b); /* again: checking the arguments may have run a finalizer */
     return status_error(L, w, carom_body_set_restitution(w, b->id, v), 2, "set_restitution");
 }

@@ -424,10 +424,16 @@ end)
 -- error paths
 ---------------------------------------------------------------------------
 
+test("mass = 0 means 'use density', as in C", function()
+  local world = carom.world{}
+  local b = world:add_body{ shape = carom.sphere{ radius = 0.5 }, mass = 0, density = 1000 }
+  near(b:mass(), 1000 * 4 / 3 * math.pi * 0.125, 1e-9, "mass from density")
+end)
+
 test("argument errors name the function and the argument (self is #1)", function()
   local world = carom.world{}
   -- the same message whether called as a method or through pcall
-  local m1 = raises("bad argument #2 to 'add_body' (mass must be positive", world.add_body, world,
+  local m1 = raises("bad argument #2 to 'add_body' (mass must be finite and >= 0", world.add_body, world,
                     { shape = sphere(), mass = -1 })
   local ok, m2 = pcall(function() return world:add_body{ shape = sphere(), mass = -1 } end)
   -- called from Lua code, the message is prefixed with the caller's position, as luaL_argerror does
@@ -483,9 +489,9 @@ test("add_body errors: each key, the world's own checks, and an unchanged world"
     { "velocity must be finite", { shape = s, velocity = {1/0, 0, 0} } },
     { "orientation must be a quaternion", { shape = s, orientation = {1, 0, 0} } },
     { "orientation", { shape = s, orientation = {2, 0, 0, 0} } },
-    { "mass must be positive", { shape = s, mass = 0 } },
+    { "mass must be finite and >= 0", { shape = s, mass = -1 } },
     { "mass must be finite", { shape = s, mass = 0/0 } },
-    { "density must be positive", { shape = s, density = -5 } },
+    { "density must be finite and >= 0", { shape = s, density = -5 } },
     { "restitution", { shape = s, restitution = 2 } },
     { "restitution", { shape = s, restitution = -0.1 } },
     { "friction", { shape = s, friction = -1 } },

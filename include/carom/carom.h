@@ -559,6 +559,11 @@ CAROM_API size_t carom_world_snapshot(const carom_world *world, void *buf, size_
  * new world has no event callback and its bodies no user data. */
 CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *msg, size_t msg_size);
 
+/* carom_body_create with the failure as a status (INVALID_ARGUMENT, LOCKED,
+ * OUT_OF_MEMORY; the last error says why): *out is the new body's id, or the
+ * null id on failure. */
+CAROM_API carom_status carom_body_try_create(carom_world *world, const carom_body_def *def, carom_body_id *out);
+
 #ifdef __cplusplus
 }
 #endif
