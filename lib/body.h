@@ -49,6 +49,8 @@ typedef struct body_store {
     int *proxy;                 /* broadphase proxy */
     aabb *fat_box;
     void **user_data;
+    uint64_t *category, *filter_mask; /* collision filtering (see carom_body_def) */
+    int *group;
     int *solver_index;          /* scratch during a step */
 } body_store;
 

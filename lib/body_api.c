@@ -7,6 +7,7 @@
 #include "array.h"
 #include "world.h"
 #include "ranges.h"
+#include "shape_def.h"
 #include "mesh.h"
 
 #define MAX_COORDINATE RANGE_COORDINATE_MAX
@@ -14,7 +15,6 @@
 static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
 static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
 static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-static int length_ok(double x) { return x >= RANGE_LENGTH_MIN && x <= RANGE_LENGTH_MAX; }
 static double len_c(carom_vec3 v) { return sqrt(v.x * v.x + v.y * v.y + v.z * v.z); } /* inf when huge */
 static int normal_ok(carom_vec3 n)
 {
@@ -58,57 +58,10 @@ static void refresh_proxy(carom_world *w, int slot)
 
 /* ---- validation of a body def ------------------------------------------------ */
 
-#define LENGTH_RANGE "[1e-6, 1e6] m"
-
+/* The shape rules are shared with the shape queries (shape_def.c). */
 static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_type type)
 {
-#define FAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
-    switch (sd->type) {
-    case CAROM_SHAPE_SPHERE:
-        if (!length_ok(sd->radius)) FAIL("body_create: sphere radius %g is outside " LENGTH_RANGE, sd->radius);
-        break;
-    case CAROM_SHAPE_BOX:
-        if (!length_ok(sd->half_extents.x) || !length_ok(sd->half_extents.y) || !length_ok(sd->half_extents.z))
-            FAIL("body_create: box half extents (%g, %g, %g) must each be in " LENGTH_RANGE, sd->half_extents.x,
-                 sd->half_extents.y, sd->half_extents.z);
-        break;
-    case CAROM_SHAPE_CAPSULE:
-    case CAROM_SHAPE_CYLINDER: {
-        const char *name = sd->type == CAROM_SHAPE_CAPSULE ? "capsule" : "cylinder";
-        if (!length_ok(sd->radius)) FAIL("body_create: %s radius %g is outside " LENGTH_RANGE, name, sd->radius);
-        if (!length_ok(sd->half_height))
-            FAIL("body_create: %s half_height %g is outside " LENGTH_RANGE, name, sd->half_height);
-        break;
-    }
-    case CAROM_SHAPE_HULL:
-        if (!sd->points || sd->point_count < 4 || sd->point_count > 100000)
-            FAIL("body_create: a hull needs 4..100000 points (got %d%s)", sd->point_count, sd->points ? "" : ", NULL array");
-        for (int i = 0; i < 3 * sd->point_count; i++)
-            if (!(fabs(sd->points[i]) <= RANGE_LENGTH_MAX))
-                FAIL("body_create: hull point %d has coordinate %g; each must be finite with |c| <= 1e6 m", i / 3,
-                     sd->points[i]);
-        break;
-    case CAROM_SHAPE_COMPOUND: /* the children are checked with the body def */
-        break;
-    case CAROM_SHAPE_MESH:
-    case CAROM_SHAPE_HEIGHTFIELD: {
-        const char *what = sd->type == CAROM_SHAPE_MESH ? "mesh" : "heightfield";
-        if (type == CAROM_BODY_DYNAMIC)
-            return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: a %s can only be a static or kinematic body "
-                              "(use a hull or a compound of convex pieces for a dynamic one)", what), 0;
-        break;
-    }
-    case CAROM_SHAPE_PLANE:
-        if (type != CAROM_BODY_STATIC) FAIL("body_create: a plane can only be a static body");
-        if (!normal_ok(sd->normal)) FAIL("body_create: plane normal must be finite with length >= 1e-12");
-        if (!(fabs(sd->offset / len_c(sd->normal)) <= RANGE_COORDINATE_MAX))
-            FAIL("body_create: plane offset %g is outside [-1e12, 1e12] m", sd->offset / len_c(sd->normal));
-        break;
-    default:
-        FAIL("body_create: unknown shape type %d", (int)sd->type);
-    }
-#undef FAIL
-    return 1;
+    return shape_def_check(w, sd, type, "body_create") == CAROM_OK;
 }
 
 /* A dynamic body's mass and inertia (fn names the caller): inside the ranges
@@ -395,6 +348,9 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->sleep_time[slot] = 0;
     s->shapes[slot] = sh;
     s->user_data[slot] = d.user_data;
+    s->category[slot] = d.category;
+    s->filter_mask[slot] = d.mask;
+    s->group[slot] = d.group;
     s->solver_index[slot] = -1;
     if (d.lock_to_plane) {
         /* keep only in-plane motion: velocity in the plane, spin about its normal */

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
+#include "filter.h"
 #include "world.h"
 #include "collision.h"
 #include "events.h"
@@ -35,7 +36,8 @@ static void add_pair(carom_world *w, int ida, int idb)
     int sa = s->ids[ida].slot, sb = s->ids[idb].slot;
     if (sa < 0 || sb < 0 || ida == idb) return;
     if (s->type[sa] != CAROM_BODY_DYNAMIC && s->type[sb] != CAROM_BODY_DYNAMIC) return;
-    if (contact_find(&w->contacts, ida, idb) >= 0) return;
+    if (!filter_bits_allow(s, sa, sb) || contact_find(&w->contacts, ida, idb) >= 0) return;
+    if (w->pair_filter && !w->pair_filter(w->pair_filter_context, world_make_id(w, ida), world_make_id(w, idb))) return;
     int ci = contact_add(&w->contacts, ida, idb);
     if (ci < 0) return; /* out of memory: the pair is retried when a proxy moves again */
     contact *c = &w->contacts.items[ci];
@@ -275,7 +277,7 @@ int world_collide(carom_world *w, const step_context *ctx)
         if (c->sub) {
             /* an extra manifold of a mesh pair: the pair's own contact (sub 0)
              * computes it; it goes when the pair does */
-            if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) contact_remove(cs, i);
+            if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || !filter_bits_allow(s, a, b)) contact_remove(cs, i);
             else i++;
             continue;
         }
@@ -283,6 +285,11 @@ int world_collide(carom_world *w, const step_context *ctx)
         int awake_b = s->type[b] != CAROM_BODY_STATIC && (s->flags[b] & BODY_AWAKE);
         int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
         c->flags &= ~(uint32_t)CONTACT_SIM;
+        if (!filter_bits_allow(s, a, b)) { /* the bits changed since the pair was made */
+            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, i, CAROM_EVENT_END);
+            contact_remove(cs, i);
+            continue;
+        }
         if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
             if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);

@@ -1,8 +1,7 @@
-/* probe.c - accuracy probes (energy, momentum) and spatial queries (ray cast,
- * AABB overlap) over the world. */
+/* probe.c - accuracy probes (energy, momentum, penetration) and the AABB
+ * query over the world (ray and shape queries: query.c). */
 #include <string.h>
 #include "world.h"
-#include "mesh.h"
 
 CAROM_API carom_status carom_world_get_energy(const carom_world *w, double *kinetic, double *potential)
 {
@@ -38,85 +37,6 @@ CAROM_API carom_status carom_world_get_momentum(const carom_world *w, carom_vec3
     if (linear) { linear->x = p.x; linear->y = p.y; linear->z = p.z; }
     if (angular) { angular->x = l.x; angular->y = l.y; angular->z = l.z; }
     return CAROM_OK;
-}
-
-typedef struct ray_query {
-    const carom_world *w;
-    carom_ray_hit *hit;
-    int found;
-    int part;              /* the hit's compound child, mesh triangle or field cell (-1 none) */
-} ray_query;
-
-/* shape_ray_cast_local, and which part of a compound or level shape was hit. */
-static int ray_cast_part(const shape *s, vec3 o, vec3 d, double max_t, double *t, vec3 *n, int *part)
-{
-    *part = -1;
-    uint32_t index = 0;
-    switch (s->type) {
-    case SHAPE_COMPOUND: return compound_ray_cast_local(s->compound, o, d, max_t, t, n, part);
-    case SHAPE_MESH:
-        if (!mesh_ray_cast(s->mesh, o, d, max_t, t, n, &index)) return 0;
-        *part = (int)index;
-        return 1;
-    case SHAPE_HEIGHTFIELD:
-        if (!heightfield_ray_cast(s->field, o, d, max_t, t, n, &index)) return 0;
-        *part = (int)index;
-        return 1;
-    default: return shape_ray_cast_local(s, o, d, max_t, t, n);
-    }
-}
-
-static double ray_visit(void *ctx, int id_index, vec3 origin, vec3 dir, double max_t)
-{
-    ray_query *q = ctx;
-    const body_store *s = &q->w->bodies;
-    int slot = s->ids[id_index].slot;
-    if (slot < 0) return max_t;
-    xform x = body_xform(s, slot);
-    vec3 o = xf_inv_point(x, origin), d = q_inv_rotate(x.q, dir);
-    double t;
-    vec3 nl;
-    int part;
-    if (!ray_cast_part(&s->shapes[slot], o, d, max_t, &t, &nl, &part) || t > max_t) return max_t;
-    q->part = part;
-    vec3 p = v3_madd(origin, t, dir), n = q_rotate(x.q, nl);
-    q->found = 1;
-    q->hit->body = world_make_id(q->w, id_index);
-    q->hit->point.x = p.x; q->hit->point.y = p.y; q->hit->point.z = p.z;
-    q->hit->normal.x = n.x; q->hit->normal.y = n.y; q->hit->normal.z = n.z;
-    q->hit->fraction = t;
-    return t; /* clip: only closer hits from now on */
-}
-
-CAROM_API int carom_world_ray_cast(const carom_world *w, carom_vec3 origin, carom_vec3 translation, carom_ray_hit *hit)
-{
-    if (!w) return -1;
-    if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast: hit is NULL"), -1;
-    vec3 o = v3(origin.x, origin.y, origin.z), d = v3(translation.x, translation.y, translation.z);
-    if (!v3_is_finite(o) || !v3_is_finite(d))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast: origin and translation must be finite"), -1;
-    memset(hit, 0, sizeof *hit);
-    if (v3_len2(d) == 0) return 0;
-    ray_query q = {w, hit, 0, -1};
-    bp_ray_cast(w->bp, o, d, 1.0, ray_visit, &q);
-    return q.found;
-}
-
-CAROM_API int carom_world_ray_cast_child(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
-                                         carom_ray_hit *hit, int *child)
-{
-    if (child) *child = -1;
-    if (!w) return -1;
-    if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast_child: hit is NULL"), -1;
-    vec3 o = v3(origin.x, origin.y, origin.z), d = v3(translation.x, translation.y, translation.z);
-    if (!v3_is_finite(o) || !v3_is_finite(d))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast_child: origin and translation must be finite"), -1;
-    memset(hit, 0, sizeof *hit);
-    if (v3_len2(d) == 0) return 0;
-    ray_query q = {w, hit, 0, -1};
-    bp_ray_cast(w->bp, o, d, 1.0, ray_visit, &q);
-    if (q.found && child) *child = q.part;
-    return q.found;
 }
 
 typedef struct box_query {

@@ -6,6 +6,7 @@
  * exactly on the surface instead of tunnelling or being pushed out softly. */
 #include <stdlib.h>
 #include <string.h>
+#include "filter.h"
 #include "world.h"
 #include "toi.h"
 
@@ -66,7 +67,7 @@ static int sweep_against(void *ctx, int id_index)
     sweep_query *q = ctx;
     const body_store *s = &q->w->bodies;
     int other = s->ids[id_index].slot;
-    if (other < 0 || other == q->slot) return 1;
+    if (other < 0 || other == q->slot || !filter_bits_allow(s, q->slot, other)) return 1;
     if (s->type[other] == CAROM_BODY_DYNAMIC && !q->bullet) return 1;
     if (s->type[other] == CAROM_BODY_DYNAMIC && (s->flags[other] & BODY_BULLET)) return 1;
     vec3 delta = v3_sub(q->end, q->start);

@@ -55,6 +55,8 @@ struct carom_world {
     carom_world_stats stats;
     int locked;                 /* inside step or a callback */
     int in_callback;
+    carom_pair_filter_fn *pair_filter; /* carom_world_set_pair_filter (filter.c) */
+    void *pair_filter_context;
     char error[WORLD_ERROR_SIZE];
     carom_status last_status;   /* the status world_fail last recorded */
 };

@@ -321,6 +321,11 @@ int clua_field_option(lua_State *L, int arg, const char *fname, const char *key,
 
 int clua_traceback(lua_State *L)
 {
+    if (lua_type(L, 1) != LUA_TSTRING && lua_type(L, 1) != LUA_TNUMBER) {
+        /* an error object (a table, say) is the script's value: pass it through */
+        lua_settop(L, 1);
+        return 1;
+    }
     const char *msg = lua_tostring(L, 1);
     if (!msg) {
         if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) msg = lua_tostring(L, -1);
@@ -347,6 +352,7 @@ CLUA_EXPORT int luaopen_carom(lua_State *L)
     clua_open_shapes(L);
     clua_open_world(L);
     clua_open_body(L);
+    clua_open_game(L);
     lua_pushcfunction(L, l_clock);
     lua_setfield(L, -2, "clock");
     lua_pushstring(L, carom_version());

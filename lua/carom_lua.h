@@ -129,5 +129,8 @@ extern const char *const clua_body_type_names[];
 void clua_open_shapes(lua_State *L);  /* metatable + carom.sphere ... carom.plane into the table on top */
 void clua_open_world(lua_State *L);   /* metatable + carom.world */
 void clua_open_body(lua_State *L);    /* metatable */
+void clua_open_game(lua_State *L);    /* wrap_game.c: filtering and query methods, after the two above */
+/* add_body's category/mask/group keys (wrap_game.c). */
+void clua_read_filter_keys(lua_State *L, int arg, const char *fname, carom_body_def *d);
 
 #endif

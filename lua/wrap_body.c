@@ -119,7 +119,8 @@ static int status_error(lua_State *L, carom_world *w, carom_status st, int arg, 
 static const char *const body_keys[] = {
     "type", "shape", "position", "velocity", "orientation", "angular_velocity", "mass", "density",
     "restitution", "friction", "bullet", "lock_rotation", "lock_to_plane", "plane_normal", "gravity_scale",
-    "damping", "linear_damping", "angular_damping", "sleep", "awake", "user_data", "data", NULL};
+    "damping", "linear_damping", "angular_damping", "sleep", "awake", "user_data", "data",
+    "category", "mask", "group", NULL};
 
 int clua_world_add_body(lua_State *L)
 {
@@ -158,6 +159,7 @@ int clua_world_add_body(lua_State *L)
     clua_field_bool(L, 2, fname, "lock_to_plane", &d.lock_to_plane);
     clua_field_bool(L, 2, fname, "sleep", &d.enable_sleep);
     clua_field_bool(L, 2, fname, "awake", &d.awake);
+    clua_read_filter_keys(L, 2, fname, &d);
     int has_user_data = clua_rawfield(L, 2, "user_data") != LUA_TNIL;
     int has_data = clua_rawfield(L, 2, "data") != LUA_TNIL;
     if (has_user_data && has_data) clua_arg_error(L, 2, fname, "give user_data or data (the same field), not both");

@@ -654,7 +654,8 @@ test("an error in a callback is raised by step after the step, with a traceback;
   assert(calls == 1)
   world:set_contact_callback(function(e) error({ code = 7 }) end) -- a non-string error
   world:add_body{ position = {18, 0, 0.7}, velocity = {0, 0, -3}, shape = sphere(0.5) }
-  raises("error object is a table value", world.step, world, 1/60, 30)
+  local ok, err = pcall(world.step, world, 1/60, 30)
+  assert(not ok and type(err) == "table" and err.code == 7, "a table thrown keeps its value: " .. tostring(err))
   world:set_contact_callback(nil)
   world:step(1/60, 30)
   local _, _, z = ball:position()

@@ -372,7 +372,15 @@ typedef struct carom_body_def {
     const carom_heightfield_def *heightfield; /* NULL: shape.type CAROM_SHAPE_HEIGHTFIELD reads it */
     const carom_compound_child *children; /* NULL: shape.type CAROM_SHAPE_COMPOUND reads child_count of them */
     int child_count;               /* 0 */
+    /* collision filtering: A and B collide when (A.category & B.mask) and
+     * (B.category & A.mask) are both non-zero, unless they share a non-zero
+     * group: a positive group always collides, a negative one never */
+    uint64_t category;             /* 1 */
+    uint64_t mask;                 /* CAROM_MASK_ALL */
+    int group;                     /* 0 */
 } carom_body_def;
+
+#define CAROM_MASK_ALL UINT64_MAX
 
 static inline carom_body_def carom_body_def_default(void)
 {
@@ -402,6 +410,9 @@ static inline carom_body_def carom_body_def_default(void)
     d.heightfield = 0;
     d.children = 0;
     d.child_count = 0;
+    d.category = 1;
+    d.mask = CAROM_MASK_ALL;
+    d.group = 0;
     return d;
 }
 
@@ -563,6 +574,85 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
  * OUT_OF_MEMORY; the last error says why): *out is the new body's id, or the
  * null id on failure. */
 CAROM_API carom_status carom_body_try_create(carom_world *world, const carom_body_def *def, carom_body_id *out);
+/* ---- filtering and game queries ---------------------------------------- */
+
+/* The filter bits of a body (see carom_body_def). Changing them drops the
+ * body's contacts that the new bits forbid (with end events) and finds the
+ * new pairs at the next step; a sleeping body stays asleep. */
+CAROM_API carom_status carom_body_set_filter(carom_world *world, carom_body_id id, uint64_t category, uint64_t mask,
+                                             int group);
+CAROM_API carom_status carom_body_get_filter(const carom_world *world, carom_body_id id, uint64_t *category,
+                                             uint64_t *mask, int *group);
+
+/* The world's pair filter: asked, during the step, about each new pair of
+ * bodies whose bits allow them to touch (again whenever either body's
+ * bounds move on, while they have no contact); return 0 and they do not
+ * touch. It runs with the world locked. NULL (the default) allows all. A
+ * contact that exists stays until the bodies separate or their bits change. */
+typedef int carom_pair_filter_fn(void *context, carom_body_id a, carom_body_id b);
+CAROM_API carom_status carom_world_set_pair_filter(carom_world *world, carom_pair_filter_fn *fn, void *context);
+
+/* Which bodies a query sees: those whose category & mask is non-zero and, if
+ * fn is set, for which fn returns non-zero. fn runs with the world locked
+ * (it may read bodies; creating, destroying and setters are refused). */
+typedef int carom_query_filter_fn(void *context, carom_body_id body);
+typedef struct carom_query_filter {
+    uint64_t mask;
+    carom_query_filter_fn *fn;
+    void *context;
+} carom_query_filter;
+
+static inline carom_query_filter carom_query_filter_default(void)
+{
+    carom_query_filter f;
+    f.mask = CAROM_MASK_ALL;
+    f.fn = 0;
+    f.context = 0;
+    return f;
+}
+
+/* Ray casts, all queries: a ray whose origin is inside (or on) a shape hits
+ * it at fraction 0, at the origin, with the normal against the ray
+ * (-translation / |translation|). filter may be NULL (every body). */
+/* Closest hit through a filter; 1 hit, 0 none, -1 bad input. */
+CAROM_API int carom_world_ray_cast_filtered(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
+                                            const carom_query_filter *filter, carom_ray_hit *hit);
+/* Every hit (one per body), nearest first: fills up to capacity and returns
+ * the total count (so a second call can size the array); -1 on bad input. */
+CAROM_API int carom_world_ray_cast_all(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
+                                       const carom_query_filter *filter, carom_ray_hit *hits, int capacity);
+/* Sweeps a convex shape (not a plane) from position/orientation along
+ * translation: the first body it touches, the fraction of the translation,
+ * the point on that body and its normal (against the sweep). A shape that
+ * overlaps a body at the start hits it at fraction 0 (normal against the
+ * sweep). 1 hit, 0 none, -1 bad input. */
+CAROM_API int carom_world_shape_cast(const carom_world *world, const carom_shape_def *shape, carom_vec3 position,
+                                     carom_quat orientation, carom_vec3 translation,
+                                     const carom_query_filter *filter, carom_ray_hit *hit);
+/* Bodies whose shape overlaps (or touches) the given convex shape at that
+ * pose, exactly (not their bounds): fills up to capacity ids, returns the
+ * total count; -1 on bad input. */
+CAROM_API int carom_world_overlap(const carom_world *world, const carom_shape_def *shape, carom_vec3 position,
+                                  carom_quat orientation, const carom_query_filter *filter, carom_body_id *ids,
+                                  int capacity);
+
+typedef struct carom_distance_result {
+    carom_body_id body;           /* the other body (shape queries) */
+    double distance;              /* between the surfaces; < 0: they overlap by that much */
+    carom_vec3 point_a, point_b;  /* closest points on A (or the query shape) and on B */
+    carom_vec3 normal;            /* unit, from A towards B */
+} carom_distance_result;
+
+/* Closest points of two bodies (at most one a plane). When they overlap the
+ * distance is minus the deepest penetration the narrowphase measures. */
+CAROM_API carom_status carom_world_body_distance(const carom_world *world, carom_body_id a, carom_body_id b,
+                                                 carom_distance_result *out);
+/* The body nearest to a convex shape at a pose, within max_distance (>= 0):
+ * 1 found, 0 none that near, -1 bad input. Overlapping bodies are at
+ * distance 0 (the first found). */
+CAROM_API int carom_world_shape_distance(const carom_world *world, const carom_shape_def *shape, carom_vec3 position,
+                                         carom_quat orientation, double max_distance,
+                                         const carom_query_filter *filter, carom_distance_result *out);
 
 #ifdef __cplusplus
 }

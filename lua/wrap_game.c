@@ -1,0 +1,321 @@
+/* wrap_game.c - what a game script asks of the world, added to carom.World
+ * and carom.Body: collision filtering (category, mask, group), ray casts
+ * returning every hit, shape casts, exact overlaps and closest distances.
+ *
+ * Masks and categories are Lua integers used as 64 bit patterns (-1, that
+ * is ~0, is every bit). A query's last argument may be a mask or a filter
+ * function fn(body) returning false to skip a body; the function runs with
+ * the world locked, and an error it raises is raised by the query once the
+ * query is over (the world unchanged). */
+#include <string.h>
+#include "carom_lua.h"
+
+/* ---- bodies ------------------------------------------------------------------ */
+
+static carom_world *game_check_body(lua_State *L, int arg, const char *fname, carom_body_id *id)
+{
+    clua_body *b = luaL_testudata(L, arg, CLUA_BODY_MT);
+    if (!b) clua_type_error(L, arg, fname, CLUA_BODY_MT);
+    lua_getiuservalue(L, arg, BODY_UV_WORLD);
+    clua_world *lw = luaL_testudata(L, -1, CLUA_WORLD_MT);
+    lua_pop(L, 1);
+    if (!lw || !lw->world) clua_arg_error(L, arg, fname, "the body's world has been destroyed");
+    if (!carom_body_is_valid(lw->world, b->id)) clua_arg_error(L, arg, fname, "body has been destroyed");
+    *id = b->id;
+    return lw->world;
+}
+
+/* An integer bit pattern at t[key] (a number with an integer value). */
+static int field_bits(lua_State *L, int arg, const char *fname, const char *key, uint64_t *out)
+{
+    int t = clua_rawfield(L, arg, key);
+    if (t == LUA_TNIL) { lua_pop(L, 1); return 0; }
+    int isint = 0;
+    lua_Integer v = lua_tointegerx(L, -1, &isint);
+    if (t != LUA_TNUMBER || !isint)
+        clua_arg_error(L, arg, fname, "%s must be an integer bit mask (got %s)", key,
+                       t == LUA_TNUMBER ? "a fraction" : lua_typename(L, t));
+    lua_pop(L, 1);
+    *out = (uint64_t)v;
+    return 1;
+}
+
+void clua_read_filter_keys(lua_State *L, int arg, const char *fname, carom_body_def *d)
+{
+    field_bits(L, arg, fname, "category", &d->category);
+    field_bits(L, arg, fname, "mask", &d->mask);
+    int group = d->group;
+    if (clua_field_int(L, arg, fname, "group", &group)) d->group = group;
+}
+
+/* body:set_filter{category=, mask=, group=}: keys left out keep their value. */
+static int body_set_filter(lua_State *L)
+{
+    static const char *const keys[] = {"category", "mask", "group", NULL};
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "set_filter", &id);
+    clua_check_table(L, 2, "set_filter");
+    clua_check_keys(L, 2, "set_filter", keys);
+    carom_body_def d = carom_body_def_default();
+    carom_body_get_filter(w, id, &d.category, &d.mask, &d.group);
+    clua_read_filter_keys(L, 2, "set_filter", &d);
+    w = game_check_body(L, 1, "set_filter", &id);
+    carom_status st = carom_body_set_filter(w, id, d.category, d.mask, d.group);
+    if (st != CAROM_OK) {
+        char buf[256];
+        return luaL_error(L, "set_filter: %s", clua_copy_error(w, buf, sizeof buf));
+    }
+    return 0;
+}
+
+/* body:filter(): {category=, mask=, group=}. */
+static int body_filter(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "filter", &id);
+    uint64_t c = 0, m = 0;
+    int g = 0;
+    carom_body_get_filter(w, id, &c, &m, &g);
+    lua_createtable(L, 0, 3);
+    lua_pushinteger(L, (lua_Integer)c);
+    lua_setfield(L, -2, "category");
+    lua_pushinteger(L, (lua_Integer)m);
+    lua_setfield(L, -2, "mask");
+    lua_pushinteger(L, g);
+    lua_setfield(L, -2, "group");
+    return 1;
+}
+
+/* ---- query filters ------------------------------------------------------------ */
+
+typedef struct lua_filter {
+    lua_State *L;
+    int fn_index;       /* the filter function on L's stack, or 0 */
+    int world_index;
+    int failed;         /* the function raised: its error is at error_index */
+    int error_index;    /* a stack slot reserved for the error */
+} lua_filter;
+
+static int call_filter(lua_State *L)
+{
+    /* 1: the function, 2: the world, 3: the body id as light data */
+    carom_body_id id = *(const carom_body_id *)lua_touserdata(L, 3);
+    lua_pushvalue(L, 1);
+    clua_push_body(L, 2, id);
+    lua_call(L, 1, 1);
+    lua_pushboolean(L, lua_toboolean(L, -1));
+    return 1;
+}
+
+static int lua_filter_fn(void *context, carom_body_id body)
+{
+    lua_filter *f = context;
+    lua_State *L = f->L;
+    if (f->failed) return 0; /* after an error, skip the rest */
+    int top = lua_gettop(L);
+    if (!lua_checkstack(L, 8)) { f->failed = 1; lua_pushliteral(L, "query filter: Lua stack overflow"); lua_replace(L, f->error_index); return 0; }
+    lua_pushcfunction(L, clua_traceback);
+    lua_pushcfunction(L, call_filter);
+    lua_pushvalue(L, f->fn_index);
+    lua_pushvalue(L, f->world_index);
+    lua_pushlightuserdata(L, &body);
+    int keep = 0;
+    if (lua_pcall(L, 3, 1, top + 1) != LUA_OK) {
+        f->failed = 1;
+        lua_replace(L, f->error_index);
+    } else {
+        keep = lua_toboolean(L, -1);
+    }
+    lua_settop(L, top);
+    return keep;
+}
+
+/* Reads the optional mask-or-function at arg into filter (and *lf). */
+static void read_query_filter(lua_State *L, int arg, const char *fname, carom_query_filter *filter, lua_filter *lf)
+{
+    *filter = carom_query_filter_default();
+    memset(lf, 0, sizeof *lf);
+    int t = lua_type(L, arg);
+    if (t == LUA_TNONE || t == LUA_TNIL) return;
+    if (t == LUA_TFUNCTION) {
+        lf->L = L;
+        lf->fn_index = lua_absindex(L, arg);
+        lf->world_index = 1;
+        lua_pushnil(L); /* the error slot */
+        lf->error_index = lua_gettop(L);
+        filter->fn = lua_filter_fn;
+        filter->context = lf;
+        return;
+    }
+    int isint = 0;
+    lua_Integer v = lua_tointegerx(L, arg, &isint);
+    if (t != LUA_TNUMBER || !isint) clua_type_error(L, arg, fname, "integer mask or filter function");
+    filter->mask = (uint64_t)v;
+}
+
+/* After the query: raises what the filter function raised. */
+static void finish_query_filter(lua_State *L, const lua_filter *lf)
+{
+    if (lf->failed) {
+        lua_pushvalue(L, lf->error_index);
+        lua_error(L);
+    }
+}
+
+/* An orientation at arg, or nil for the identity; returns the next index. */
+static int check_orientation(lua_State *L, int arg, const char *fname, carom_quat *q)
+{
+    if (lua_isnoneornil(L, arg)) {
+        q->w = 1; q->x = q->y = q->z = 0;
+        return arg + 1;
+    }
+    return clua_check_quat(L, arg, fname, q);
+}
+
+static int query_error(lua_State *L, clua_world *lw, int arg, const char *fname)
+{
+    char buf[256];
+    return clua_arg_error(L, arg, fname, "%s", clua_copy_error(lw->world, buf, sizeof buf));
+}
+
+static void push_hit(lua_State *L, const carom_ray_hit *h)
+{
+    lua_createtable(L, 0, 4);
+    clua_push_body(L, 1, h->body);
+    lua_setfield(L, -2, "body");
+    clua_push_vec3_table(L, h->point);
+    lua_setfield(L, -2, "point");
+    clua_push_vec3_table(L, h->normal);
+    lua_setfield(L, -2, "normal");
+    lua_pushnumber(L, h->fraction);
+    lua_setfield(L, -2, "fraction");
+}
+
+/* ---- world queries -------------------------------------------------------------- */
+
+/* world:ray_cast_all(origin, translation [, mask or fn]): hits nearest first,
+ * each {body=, point=, normal=, fraction=}. */
+static int world_ray_cast_all(lua_State *L)
+{
+    const char *fname = "ray_cast_all";
+    clua_world *lw = clua_check_world(L, 1, fname);
+    carom_vec3 origin, translation;
+    int next = clua_check_vec3(L, 2, fname, &origin);
+    next = clua_check_vec3(L, next, fname, &translation);
+    carom_query_filter filter;
+    lua_filter lf;
+    read_query_filter(L, next, fname, &filter, &lf);
+    lw = clua_check_world(L, 1, fname);
+    int n = carom_world_ray_cast_all(lw->world, origin, translation, &filter, NULL, 0);
+    finish_query_filter(L, &lf);
+    if (n < 0) return query_error(L, lw, 2, fname);
+    carom_ray_hit *hits = lua_newuserdatauv(L, sizeof *hits * (size_t)(n > 0 ? n : 1), 0);
+    lw = clua_check_world(L, 1, fname);
+    int got = carom_world_ray_cast_all(lw->world, origin, translation, &filter, hits, n);
+    finish_query_filter(L, &lf);
+    if (got > n) got = n;
+    lua_createtable(L, got > 0 ? got : 0, 0);
+    for (int i = 0; i < got; i++) {
+        push_hit(L, &hits[i]);
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
+/* world:shape_cast(shape, position, orientation, translation [, mask or fn]):
+ * body, fraction, point, normal of the first hit, or nil. */
+static int world_shape_cast(lua_State *L)
+{
+    const char *fname = "shape_cast";
+    clua_world *lw = clua_check_world(L, 1, fname);
+    const carom_shape_def *shape = &clua_check_shape(L, 2, fname)->def;
+    carom_vec3 position, translation;
+    carom_quat orientation;
+    int next = clua_check_vec3(L, 3, fname, &position);
+    next = check_orientation(L, next, fname, &orientation);
+    next = clua_check_vec3(L, next, fname, &translation);
+    carom_query_filter filter;
+    lua_filter lf;
+    read_query_filter(L, next, fname, &filter, &lf);
+    lw = clua_check_world(L, 1, fname);
+    carom_ray_hit hit;
+    int r = carom_world_shape_cast(lw->world, shape, position, orientation, translation, &filter, &hit);
+    finish_query_filter(L, &lf);
+    if (r < 0) return query_error(L, lw, 2, fname);
+    if (r == 0) {
+        lua_pushnil(L);
+        return 1;
+    }
+    clua_push_body(L, 1, hit.body);
+    lua_pushnumber(L, hit.fraction);
+    clua_push_vec3_table(L, hit.point);
+    clua_push_vec3_table(L, hit.normal);
+    return 4;
+}
+
+/* world:overlap(shape, position, orientation [, mask or fn]): the bodies
+ * whose shapes overlap it, in id order. */
+static int world_overlap(lua_State *L)
+{
+    const char *fname = "overlap";
+    clua_world *lw = clua_check_world(L, 1, fname);
+    const carom_shape_def *shape = &clua_check_shape(L, 2, fname)->def;
+    carom_vec3 position;
+    carom_quat orientation;
+    int next = clua_check_vec3(L, 3, fname, &position);
+    next = check_orientation(L, next, fname, &orientation);
+    carom_query_filter filter;
+    lua_filter lf;
+    read_query_filter(L, next, fname, &filter, &lf);
+    lw = clua_check_world(L, 1, fname);
+    int n = carom_world_overlap(lw->world, shape, position, orientation, &filter, NULL, 0);
+    finish_query_filter(L, &lf);
+    if (n < 0) return query_error(L, lw, 2, fname);
+    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    lw = clua_check_world(L, 1, fname);
+    int got = carom_world_overlap(lw->world, shape, position, orientation, &filter, ids, n);
+    finish_query_filter(L, &lf);
+    if (got > n) got = n;
+    lua_createtable(L, got > 0 ? got : 0, 0);
+    for (int i = 0; i < got; i++) {
+        clua_push_body(L, 1, ids[i]);
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
+/* world:distance(a, b): distance (negative when they overlap), point on a,
+ * point on b. */
+static int world_distance(lua_State *L)
+{
+    const char *fname = "distance";
+    clua_world *lw = clua_check_world(L, 1, fname);
+    carom_body_id a, b;
+    carom_world *wa = game_check_body(L, 2, fname, &a);
+    carom_world *wb = game_check_body(L, 3, fname, &b);
+    if (wa != lw->world) clua_arg_error(L, 2, fname, "body belongs to another world");
+    if (wb != lw->world) clua_arg_error(L, 3, fname, "body belongs to another world");
+    carom_distance_result r;
+    carom_status st = carom_world_body_distance(lw->world, a, b, &r);
+    if (st != CAROM_OK) return query_error(L, lw, 3, fname);
+    lua_pushnumber(L, r.distance);
+    clua_push_vec3_table(L, r.point_a);
+    clua_push_vec3_table(L, r.point_b);
+    return 3;
+}
+
+void clua_open_game(lua_State *L)
+{
+    static const luaL_Reg world_methods[] = {{"ray_cast_all", world_ray_cast_all}, {"shape_cast", world_shape_cast},
+                                             {"overlap", world_overlap}, {"distance", world_distance}, {NULL, NULL}};
+    static const luaL_Reg body_methods[] = {{"set_filter", body_set_filter}, {"filter", body_filter}, {NULL, NULL}};
+    luaL_getmetatable(L, CLUA_WORLD_MT);
+    lua_getfield(L, -1, "__index");
+    luaL_setfuncs(L, world_methods, 0);
+    lua_pop(L, 2);
+    luaL_getmetatable(L, CLUA_BODY_MT);
+    lua_getfield(L, -1, "__index"); /* a closure over the methods table */
+    lua_getupvalue(L, -1, 1);
+    luaL_setfuncs(L, body_methods, 0);
+    lua_pop(L, 3);
+}

@@ -1,0 +1,148 @@
+-- game_api_test.lua - the Lua side of filtering and queries (issue "what a
+-- game script needs"): add_body's category/mask/group, set_filter, every
+-- query with a mask and with a filter function, and their errors. Values are
+-- the geometry worked by hand. Run by `make check` with carom-run --test.
+local carom = require "carom"
+local passed, failed = 0, 0
+
+local function test(name, fn)
+  local ok, err = xpcall(fn, debug.traceback)
+  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
+end
+
+local function near(got, want, tol, what)
+  if type(got) ~= "number" or not (math.abs(got - want) <= tol) then
+    error(string.format("%s: got %s, expected %.12g (tolerance %g)", what or "value", tostring(got), want, tol), 2)
+  end
+end
+
+local function raises(text, fn, ...)
+  local ok, err = pcall(fn, ...)
+  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
+  if not tostring(err):find(text, 1, true) then
+    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
+  end
+end
+
+local function ground_and_ball(ground_keys, ball_keys)
+  local w = carom.world{}
+  local g = { type = "static", shape = carom.box{ half_extents = {5, 5, 0.5} }, position = {0, 0, -0.5} }
+  for k, v in pairs(ground_keys or {}) do g[k] = v end
+  local b = { shape = carom.sphere{ radius = 0.25 }, position = {0, 0, 0.5} }
+  for k, v in pairs(ball_keys or {}) do b[k] = v end
+  return w, w:add_body(g), w:add_body(b)
+end
+
+local function lands(ground_keys, ball_keys)
+  local w, _, ball = ground_and_ball(ground_keys, ball_keys)
+  w:step(1/60, 60)
+  local _, _, z = ball:position()
+  return math.abs(z - 0.25) < 0.01
+end
+
+test("category and mask at creation, both directions", function()
+  assert(lands({}, {}))
+  assert(not lands({ category = 2 }, { mask = 1 }))
+  assert(not lands({ mask = 1 }, { category = 2 }))
+  assert(lands({ category = 2 }, { mask = 3 }))
+  assert(lands({ category = 1 << 63 }, { mask = -1 }), "the top bit and -1 = every bit")
+end)
+
+test("groups: negative never, positive always, over the bits", function()
+  assert(not lands({ group = -2 }, { group = -2 }))
+  assert(lands({ group = 2, mask = 0 }, { group = 2, mask = 0 }))
+  assert(not lands({ group = 2, mask = 0 }, { group = 3 }))
+end)
+
+test("set_filter at runtime on a sleeping body", function()
+  local w, g, ball = ground_and_ball({}, { position = {0, 0, 0.26} })
+  w:step(1/60, 120)
+  assert(not ball:is_awake())
+  ball:set_filter{ mask = 2 }
+  local f = ball:filter()
+  assert(f.category == 1 and f.mask == 2 and f.group == 0)
+  w:step(1/60, 20)
+  local _, _, z = ball:position()
+  assert(z < 0.2, "it fell: " .. z)
+  raises("mask must be an integer", ball.set_filter, ball, { mask = 1.5 })
+  raises("unknown", ball.set_filter, ball, { colour = 1 })
+  ball:destroy()
+  raises("destroyed", ball.set_filter, ball, { mask = 1 })
+end)
+
+local function row()
+  local w = carom.world{ gravity = {0, 0, 0} }
+  local bodies = {}
+  for i = 1, 4 do
+    bodies[i] = w:add_body{ type = "static", shape = carom.sphere{ radius = 0.5 }, position = {2 * i, 0, 0},
+                            category = i % 2 == 0 and 2 or 1 }
+  end
+  return w, bodies
+end
+
+test("ray_cast_all: nearest first, with a mask and a function", function()
+  local w, b = row()
+  local hits = w:ray_cast_all({0, 0, 0}, {10, 0, 0})
+  assert(#hits == 4)
+  for i = 1, 4 do
+    assert(hits[i].body == b[i])
+    near(hits[i].point[1], 2 * i - 0.5, 1e-12, "hit x")
+    near(hits[i].fraction, (2 * i - 0.5) / 10, 1e-12, "fraction")
+    near(hits[i].normal[1], -1, 1e-12, "normal")
+  end
+  hits = w:ray_cast_all({0, 0, 0}, {10, 0, 0}, 2)
+  assert(#hits == 2 and hits[1].body == b[2] and hits[2].body == b[4])
+  hits = w:ray_cast_all({0, 0, 0}, {10, 0, 0}, function(body) return body ~= b[3] end)
+  assert(#hits == 3 and hits[3].body == b[4])
+  -- the ray convention: from inside, a hit at fraction 0 against the ray
+  hits = w:ray_cast_all({2, 0, 0}, {10, 0, 0})
+  assert(#hits == 4 and hits[1].fraction == 0 and hits[1].normal[1] == -1)
+end)
+
+test("shape_cast, overlap, distance", function()
+  local w, b = row()
+  local body, fraction, point, normal = w:shape_cast(carom.sphere{ radius = 0.25 }, {0, 0, 0}, nil, {10, 0, 0})
+  assert(body == b[1])
+  near(fraction, 1.25 / 10, 1e-9, "fraction")
+  near(point[1], 1.5, 1e-9, "point")
+  near(normal[1], -1, 1e-9, "normal")
+  body = w:shape_cast(carom.sphere{ radius = 0.25 }, {0, 0, 0}, {1, 0, 0, 0}, {10, 0, 0}, 2)
+  assert(body == b[2])
+  assert(w:shape_cast(carom.box{ half_extents = {0.1, 0.1, 0.1} }, {0, 0, 3}, nil, {10, 0, 0}) == nil)
+  local over = w:overlap(carom.box{ half_extents = {1.2, 0.2, 0.2} }, {2.5, 0, 0})
+  assert(#over == 2 and over[1] == b[1] and over[2] == b[2])
+  -- the box's corner region near a sphere's bounds but not its surface: not an overlap
+  over = w:overlap(carom.box{ half_extents = {0.2, 0.2, 0.2} }, {2.6, 0.6, 0})
+  assert(#over == 0)
+  local d, pa, pb = w:distance(b[1], b[2])
+  near(d, 1.0, 1e-12, "distance")
+  near(pa[1], 2.5, 1e-12, "point on a")
+  near(pb[1], 3.5, 1e-12, "point on b")
+end)
+
+test("query errors name the argument and leave the world as it was", function()
+  local w, b = row()
+  raises("bad argument #4 to 'ray_cast_all'", w.ray_cast_all, w, {0, 0, 0}, {1, 0, 0}, "all")
+  raises("bad argument #2 to 'shape_cast'", w.shape_cast, w, {}, {0, 0, 0}, nil, {1, 0, 0})
+  raises("finite", w.shape_cast, w, carom.sphere{ radius = 1 }, {0 / 0, 0, 0}, nil, {1, 0, 0})
+  raises("plane", w.overlap, w, carom.plane{}, {0, 0, 0})
+  raises("same body", w.distance, w, b[1], b[1])
+  local other = carom.world{}
+  local stranger = other:add_body{ shape = carom.sphere{ radius = 1 } }
+  raises("another world", w.distance, w, b[1], stranger)
+  b[4]:destroy()
+  raises("destroyed", w.distance, w, b[1], b[4])
+  -- a filter function that raises: the query raises it (a table keeps its value)
+  local ok, err = pcall(w.ray_cast_all, w, {0, 0, 0}, {10, 0, 0}, function() error({ code = 3 }) end)
+  assert(not ok and type(err) == "table" and err.code == 3)
+  ok, err = pcall(w.overlap, w, carom.sphere{ radius = 9 }, {0, 0, 0}, nil, function() error("no way") end)
+  assert(not ok and tostring(err):find("no way", 1, true))
+  -- one that destroys bodies is refused
+  ok, err = pcall(w.overlap, w, carom.sphere{ radius = 9 }, {0, 0, 0}, nil, function(body) body:destroy() end)
+  assert(not ok and tostring(err):find("locked", 1, true) or tostring(err):find("callback", 1, true), tostring(err))
+  assert(w:body_count() == 3 and b[1]:is_valid())
+  w:step(1/60)
+end)
+
+print(string.format("%d passed, %d failed", passed, failed))
+if failed > 0 then os.exit(1) end
