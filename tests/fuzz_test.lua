@@ -189,6 +189,8 @@ local function try(what, f, ...)
   local ok, err = pcall(f, ...)
   if ok then ok_calls = ok_calls + 1
   elseif type(err) == "string" then error_calls = error_calls + 1
+  elseif type(err) == "table" and tostring(err) == "table error" then
+    error_calls = error_calls + 1 -- a callback's thrown table arrives as itself
   else
     bad_errors = bad_errors + 1
     print(string.format("call %d (%s): the error is a %s, not a message", call_number, what, type(err)))
