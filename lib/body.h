@@ -51,6 +51,8 @@ typedef struct body_store {
     void **user_data;
     uint64_t *category, *filter_mask; /* collision filtering (see carom_body_def) */
     int *group;
+    vec3 *previous_origin;      /* the pose at the start of the last step (interpolation) */
+    quat *previous_rotation;
     int *solver_index;          /* scratch during a step */
 } body_store;
 

@@ -9,6 +9,7 @@
 #include "ranges.h"
 #include "shape_def.h"
 #include "mesh.h"
+#include "deferred.h"
 
 #define MAX_COORDINATE RANGE_COORDINATE_MAX
 
@@ -348,6 +349,8 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->sleep_time[slot] = 0;
     s->shapes[slot] = sh;
     s->user_data[slot] = d.user_data;
+    s->previous_origin[slot] = to_v3(d.position);
+    s->previous_rotation[slot] = q;
     s->category[slot] = d.category;
     s->filter_mask[slot] = d.mask;
     s->group[slot] = d.group;
@@ -539,6 +542,7 @@ CAROM_API carom_status carom_body_set_position(carom_world *w, carom_body_id id,
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_position: position (%g, %g, %g) must be finite with |x| <= 1e12 m", p.x, p.y, p.z);
     body_store *s = &w->bodies;
     s->center[slot] = v3_add(to_v3(p), q_rotate(s->rotation[slot], s->local_center[slot]));
+    s->previous_origin[slot] = to_v3(p); /* a teleport: nothing to interpolate across */
     if (s->flags[slot] & BODY_LOCK_PLANE) s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
     refresh_proxy(w, slot);
     world_wake_body(w, slot);
@@ -554,6 +558,7 @@ CAROM_API carom_status carom_body_set_orientation(carom_world *w, carom_body_id 
     vec3 origin = body_origin(s, slot);
     s->rotation[slot] = q_normalize((quat){q.w, q.x, q.y, q.z});
     s->center[slot] = v3_add(origin, q_rotate(s->rotation[slot], s->local_center[slot]));
+    s->previous_rotation[slot] = s->rotation[slot];
     body_update_inertia(s, slot);
     refresh_proxy(w, slot);
     world_wake_body(w, slot);
@@ -563,6 +568,7 @@ CAROM_API carom_status carom_body_set_orientation(carom_world *w, carom_body_id 
 CAROM_API carom_status carom_body_set_linear_velocity(carom_world *w, carom_body_id id, carom_vec3 v)
 {
     GET_SLOT(w, id, "body_set_linear_velocity");
+    if (w->in_callback) return world_defer_op(w, DEFER_LINEAR_VELOCITY, id, v, NULL, "body_set_linear_velocity");
     REQUIRE_UNLOCKED(w, "body_set_linear_velocity");
     if (!finite_c(v)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_linear_velocity: velocity must be finite");
     if (!speed_ok(v, w->def.max_linear_speed))
@@ -582,6 +588,7 @@ CAROM_API carom_status carom_body_set_linear_velocity(carom_world *w, carom_body
 CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_body_id id, carom_vec3 av)
 {
     GET_SLOT(w, id, "body_set_angular_velocity");
+    if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_VELOCITY, id, av, NULL, "body_set_angular_velocity");
     REQUIRE_UNLOCKED(w, "body_set_angular_velocity");
     if (!finite_c(av)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_angular_velocity: must be finite");
     if (!speed_ok(av, w->def.max_angular_speed))
@@ -724,6 +731,7 @@ CAROM_API carom_status carom_body_set_awake(carom_world *w, carom_body_id id, in
 CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id, carom_vec3 j, const carom_vec3 *point)
 {
     GET_SLOT(w, id, "body_apply_impulse");
+    if (w->in_callback) return world_defer_op(w, DEFER_IMPULSE, id, j, point, "body_apply_impulse");
     REQUIRE_UNLOCKED(w, "body_apply_impulse");
     if (!finite_c(j)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: impulse must be finite");
     if (point && !finite_c(*point)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: point must be finite");
@@ -758,6 +766,7 @@ CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id
 CAROM_API carom_status carom_body_apply_force(carom_world *w, carom_body_id id, carom_vec3 force)
 {
     GET_SLOT(w, id, "body_apply_force");
+    if (w->in_callback) return world_defer_op(w, DEFER_FORCE, id, force, NULL, "body_apply_force");
     REQUIRE_UNLOCKED(w, "body_apply_force");
     if (!finite_c(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_force: force must be finite");
     body_store *s = &w->bodies;

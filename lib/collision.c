@@ -286,7 +286,7 @@ int world_collide(carom_world *w, const step_context *ctx)
         int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!filter_bits_allow(s, a, b)) { /* the bits changed since the pair was made */
-            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) push_touch_event(w, i, CAROM_EVENT_END);
+            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }

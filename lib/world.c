@@ -6,6 +6,8 @@
 #include <string.h>
 #include <time.h>
 #include "array.h"
+#include "body_calls.h"
+#include "deferred.h"
 #include "world.h"
 #include "ranges.h"
 #include "collision.h"
@@ -189,7 +191,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     solver_memory_free(&s->solver);
     impact_memory_free(&s->impact);
-    free(s->island_parent); free(s->deferred_destroy);
+    free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
     free(s->tight_box); free(s->pose); free(s->touching);
     free(s->new_pairs);
     free(w);
@@ -286,6 +288,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     step_context ctx;
     step_context_init(&ctx, &w->def, dt);
     w->events.count = 0;
+    world_remember_poses(w);
     w->stats.clamped = 0;
     w->stats.toi_events = 0;
 
@@ -324,6 +327,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
         w->in_callback = 0;
     }
     w->locked = 0;
+    world_run_deferred_ops(w);
     run_deferred_destroys(w);
     w->stats.ms_total = now_ms() - t0;
     if (!ok) return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "step: out of memory (the step was not solved)");

@@ -43,6 +43,8 @@ typedef struct step_scratch {
     int deferred_count, deferred_capacity;
     uint64_t *new_pairs;        /* pairs the broadphase found this step, sorted before they are added */
     int new_pair_count, new_pair_capacity;
+    struct deferred_op *deferred_ops; /* velocity changes from callbacks (deferred.c) */
+    int deferred_op_count, deferred_op_capacity;
 } step_scratch;
 
 struct carom_world {

@@ -7,6 +7,7 @@
  * function fn(body) returning false to skip a body; the function runs with
  * the world locked, and an error it raises is raised by the query once the
  * query is over (the world unchanged). */
+#include <stdlib.h>
 #include <string.h>
 #include "carom_lua.h"
 
@@ -304,11 +305,123 @@ static int world_distance(lua_State *L)
     return 3;
 }
 
+/* ---- body calls ------------------------------------------------------------------ */
+
+static int game_status(lua_State *L, carom_world *w, carom_status st, int arg, const char *fname)
+{
+    if (st == CAROM_OK) return 0;
+    char buf[256];
+    const char *msg = clua_copy_error(w, buf, sizeof buf);
+    if (st == CAROM_ERROR_INVALID_ARGUMENT && arg > 0) return clua_arg_error(L, arg, fname, "%s", msg);
+    return luaL_error(L, "%s: %s", fname, msg);
+}
+
+/* body:apply_angular_impulse(L): spin changes by I^-1 L (deferred inside a callback). */
+static int body_apply_angular_impulse(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "apply_angular_impulse", &id);
+    carom_vec3 v;
+    clua_check_vec3(L, 2, "apply_angular_impulse", &v);
+    w = game_check_body(L, 1, "apply_angular_impulse", &id);
+    return game_status(L, w, carom_body_apply_angular_impulse(w, id, v), 2, "apply_angular_impulse");
+}
+
+/* body:set_damping(linear, angular) */
+static int body_set_damping(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "set_damping", &id);
+    double lin = clua_check_number(L, 2, "set_damping"), ang = clua_check_number(L, 3, "set_damping");
+    carom_status st = carom_body_set_damping(w, id, lin, ang);
+    if (st == CAROM_ERROR_INVALID_ARGUMENT) {
+        char buf[256];
+        const char *msg = clua_copy_error(w, buf, sizeof buf);
+        return clua_arg_error(L, strstr(msg, "angular") ? 3 : 2, "set_damping", "%s", msg);
+    }
+    return game_status(L, w, st, 2, "set_damping");
+}
+
+/* body:damping(): linear, angular */
+static int body_damping(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "damping", &id);
+    double lin = 0, ang = 0;
+    carom_body_get_damping(w, id, &lin, &ang);
+    lua_pushnumber(L, lin);
+    lua_pushnumber(L, ang);
+    return 2;
+}
+
+typedef carom_status convert_fn(const carom_world *, carom_body_id, carom_vec3, carom_vec3 *);
+static int convert(lua_State *L, const char *fname, convert_fn *fn)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, fname, &id);
+    carom_vec3 in, out = {0, 0, 0};
+    clua_check_vec3(L, 2, fname, &in);
+    w = game_check_body(L, 1, fname, &id);
+    game_status(L, w, fn(w, id, in, &out), 2, fname);
+    return clua_return_vec3(L, out);
+}
+static int body_world_point(lua_State *L) { return convert(L, "world_point", carom_body_get_world_point); }
+static int body_local_point(lua_State *L) { return convert(L, "local_point", carom_body_get_local_point); }
+static int body_world_vector(lua_State *L) { return convert(L, "world_vector", carom_body_get_world_vector); }
+static int body_local_vector(lua_State *L) { return convert(L, "local_vector", carom_body_get_local_vector); }
+
+/* body:shape(): a new shape value equal to the body's (usable in add_body and queries). */
+static int body_shape(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "shape", &id);
+    carom_shape_def d;
+    carom_body_get_shape(w, id, &d);
+    clua_shape *s = lua_newuserdatauv(L, sizeof *s, 0);
+    memset(s, 0, sizeof *s);
+    luaL_setmetatable(L, CLUA_SHAPE_MT); /* its __gc frees the points */
+    if (d.type == CAROM_SHAPE_HULL) {
+        s->points = malloc(sizeof(double) * 3 * (size_t)d.point_count);
+        if (!s->points) return luaL_error(L, "shape: out of memory");
+        memcpy(s->points, d.points, sizeof(double) * 3 * (size_t)d.point_count);
+        d.points = s->points;
+    }
+    s->def = d;
+    return 1;
+}
+
+static int body_previous_position(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "previous_position", &id);
+    carom_vec3 p = {0, 0, 0};
+    carom_body_get_previous_position(w, id, &p);
+    return clua_return_vec3(L, p);
+}
+
+static int body_previous_orientation(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "previous_orientation", &id);
+    carom_quat q = {1, 0, 0, 0};
+    carom_body_get_previous_orientation(w, id, &q);
+    lua_pushnumber(L, q.w);
+    lua_pushnumber(L, q.x);
+    lua_pushnumber(L, q.y);
+    lua_pushnumber(L, q.z);
+    return 4;
+}
+
 void clua_open_game(lua_State *L)
 {
     static const luaL_Reg world_methods[] = {{"ray_cast_all", world_ray_cast_all}, {"shape_cast", world_shape_cast},
                                              {"overlap", world_overlap}, {"distance", world_distance}, {NULL, NULL}};
-    static const luaL_Reg body_methods[] = {{"set_filter", body_set_filter}, {"filter", body_filter}, {NULL, NULL}};
+    static const luaL_Reg body_methods[] = {
+        {"set_filter", body_set_filter}, {"filter", body_filter}, {"apply_angular_impulse", body_apply_angular_impulse},
+        {"set_damping", body_set_damping}, {"damping", body_damping}, {"world_point", body_world_point},
+        {"local_point", body_local_point}, {"world_vector", body_world_vector}, {"local_vector", body_local_vector},
+        {"shape", body_shape}, {"previous_position", body_previous_position},
+        {"previous_orientation", body_previous_orientation}, {NULL, NULL}};
     luaL_getmetatable(L, CLUA_WORLD_MT);
     lua_getfield(L, -1, "__index");
     luaL_setfuncs(L, world_methods, 0);

@@ -144,5 +144,72 @@ test("query errors name the argument and leave the world as it was", function()
   w:step(1/60)
 end)
 
+test("body calls: angular impulse, damping, frames, shape, previous pose", function()
+  local w = carom.world{ gravity = {0, 0, 0} }
+  local m, hx, hy, hz = 2, 0.5, 0.25, 0.125
+  local b = w:add_body{ shape = carom.box{ half_extents = {hx, hy, hz} }, mass = m, sleep = false }
+  b:apply_angular_impulse(0, 0, 1)
+  local _, _, wz = b:angular_velocity()
+  near(wz, 1 / (m * (hx * hx + hy * hy) / 3), 1e-12, "spin = L / I")
+  b:set_damping(0.5, 0.25)
+  local lin, ang = b:damping()
+  assert(lin == 0.5 and ang == 0.25)
+  raises("bad argument #3 to 'set_damping'", b.set_damping, b, 0, -1)
+  raises("bad argument #2 to 'set_damping'", b.set_damping, b, 0 / 0, 1)
+  b:set_position(1, 2, 3)
+  local x, y, z = b:world_point(1, 0, 0)
+  assert(x == 2 and y == 2 and z == 3)
+  x, y, z = b:local_point(2, 2, 3)
+  assert(x == 1 and y == 0 and z == 0)
+  x, y, z = b:world_vector{0, 1, 0}
+  assert(x == 0 and y == 1 and z == 0)
+  x, y, z = b:local_vector(0, 0, 1)
+  assert(z == 1)
+  local s = b:shape()
+  assert(s.type == "box" or tostring(s):find("box"), tostring(s))
+  local twin = w:add_body{ shape = s, mass = m, position = {5, 0, 0} }
+  near(twin:mass(), m, 0, "same shape, same mass")
+  local hull = w:add_body{ shape = carom.hull{ {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1} }, position = {9, 0, 0} }
+  local copy = w:add_body{ shape = hull:shape(), position = {12, 0, 0} }
+  near(copy:mass(), hull:mass(), 1e-9 * hull:mass(), "hull copied")
+  -- the pose at the start of the last step
+  local ball = w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {0, 5, 0}, velocity = {1, 0, 0} }
+  w:step(0.5)
+  local px = ball:previous_position()
+  local cx = ball:position()
+  assert(px == 0 and math.abs(cx - 0.5) < 1e-12, px .. " " .. cx)
+  local qw = ball:previous_orientation()
+  assert(qw == 1)
+  b:destroy()
+  raises("destroyed", b.previous_position, b)
+end)
+
+test("velocity changes inside a contact callback take effect once, after it", function()
+  local w = carom.world{ gravity = {0, 0, 0} }
+  local a = w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {-0.55, 0, 0}, velocity = {1, 0, 0}, sleep = false }
+  local b = w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {0.55, 0, 0}, velocity = {-1, 0, 0}, sleep = false }
+  local by = w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {0, 10, 0}, sleep = false }
+  local calls = 0
+  w:set_contact_callback(function(e)
+    if e.type == "begin" then
+      calls = calls + 1
+      by:apply_impulse(0, 2, 0)
+      by:set_velocity(by:velocity()) -- read before the queued impulse: (0, 0, 0), applied after it
+      by:apply_impulse(0, 0, 3)
+    end
+  end)
+  w:step(1/60, 30)
+  assert(calls == 1)
+  local vx, vy, vz = by:velocity()
+  near(vy, 0, 0, "set_velocity ran after the first impulse")
+  near(vz, 3 / by:mass(), 1e-15, "the last impulse, once")
+  raises("finite", function()
+    w:set_contact_callback(function(e) by:apply_impulse(0 / 0, 0, 0) end)
+    w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {3, 0, 0}, velocity = {-3, 0, 0} }
+    w:add_body{ shape = carom.sphere{ radius = 0.5 }, position = {1.9, 0, 0} }
+    w:step(1/60, 30)
+  end)
+end)
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

@@ -654,6 +654,38 @@ CAROM_API int carom_world_shape_distance(const carom_world *world, const carom_s
                                          carom_quat orientation, double max_distance,
                                          const carom_query_filter *filter, carom_distance_result *out);
 
+
+/* ---- more body calls ----------------------------------------------------- */
+
+/* Inside an event callback, carom_body_set_linear_velocity,
+ * carom_body_set_angular_velocity, carom_body_apply_impulse,
+ * carom_body_apply_angular_impulse and carom_body_apply_force are queued
+ * (their vectors checked then) and applied once, in call order, right after
+ * the step's callbacks; a body destroyed meanwhile is skipped. */
+/* Changes the angular velocity by I^-1 impulse (N m s). Wakes the body. */
+CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *world, carom_body_id id, carom_vec3 impulse);
+CAROM_API carom_status carom_body_set_damping(carom_world *world, carom_body_id id, double linear, double angular);
+CAROM_API carom_status carom_body_get_damping(const carom_world *world, carom_body_id id, double *linear,
+                                              double *angular);
+/* Between the body frame (origin and axes of position/orientation) and the world. */
+CAROM_API carom_status carom_body_get_world_point(const carom_world *world, carom_body_id id, carom_vec3 local,
+                                                  carom_vec3 *out);
+CAROM_API carom_status carom_body_get_local_point(const carom_world *world, carom_body_id id, carom_vec3 world_point,
+                                                  carom_vec3 *out);
+CAROM_API carom_status carom_body_get_world_vector(const carom_world *world, carom_body_id id, carom_vec3 local,
+                                                   carom_vec3 *out);
+CAROM_API carom_status carom_body_get_local_vector(const carom_world *world, carom_body_id id, carom_vec3 world_vector,
+                                                   carom_vec3 *out);
+/* The body's shape as a def (a hull's points are the hull's vertices, valid
+ * while the body lives; a plane's normal is unit). */
+CAROM_API carom_status carom_body_get_shape(const carom_world *world, carom_body_id id, carom_shape_def *out);
+/* The pose at the start of the last step, to interpolate a render between
+ * it and the current pose (after advance(): alpha). A new or teleported
+ * (set_position / set_orientation) body's previous pose is its pose then. */
+CAROM_API carom_status carom_body_get_previous_position(const carom_world *world, carom_body_id id, carom_vec3 *out);
+CAROM_API carom_status carom_body_get_previous_orientation(const carom_world *world, carom_body_id id,
+                                                           carom_quat *out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,152 @@
+/* body_calls.c - the body calls a game reaches for beyond the basics:
+ * angular impulses, damping after creation, frame conversions, the shape
+ * back as a def, and the previous pose for interpolation. */
+#include "body_calls.h"
+#include "deferred.h"
+#include "ranges.h"
+#include "world.h"
+
+static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
+static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
+static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+
+static int slot_of(const carom_world *w, carom_body_id id, const char *fn)
+{
+    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
+    if (slot < 0) world_fail(w, CAROM_ERROR_STALE_ID, "%s: body has been destroyed (or the id is invalid)", fn);
+    return slot;
+}
+
+#define SLOT_OR_FAIL(fn)                                       \
+    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;               \
+    int slot = slot_of(w, id, fn);                             \
+    if (slot < 0) return CAROM_ERROR_STALE_ID;
+#define OUT_OR_FAIL(p, fn) \
+    if (!(p)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);
+
+void world_remember_poses(carom_world *w)
+{
+    body_store *s = &w->bodies;
+    for (int i = 0; i < s->count; i++) {
+        s->previous_origin[i] = body_origin(s, i);
+        s->previous_rotation[i] = s->rotation[i];
+    }
+}
+
+CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *w, carom_body_id id, carom_vec3 impulse)
+{
+    const char *fn = "body_apply_angular_impulse";
+    SLOT_OR_FAIL(fn);
+    if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_IMPULSE, id, impulse, NULL, fn);
+    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", fn);
+    if (!finite_c(impulse)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: impulse must be finite", fn);
+    body_store *s = &w->bodies;
+    if (s->type[slot] != CAROM_BODY_DYNAMIC || (s->flags[slot] & BODY_LOCK_ROTATION)) return CAROM_OK;
+    vec3 nw = v3_add(s->angular_velocity[slot], m3_mulv(s->inv_inertia_world[slot], to_v3(impulse)));
+    if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
+    if (!(v3_len(nw) <= w->def.max_angular_speed))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "%s: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s", fn, v3_len(nw),
+                          w->def.max_angular_speed);
+    s->angular_velocity[slot] = nw;
+    world_wake_body(w, slot);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_set_damping(carom_world *w, carom_body_id id, double linear, double angular)
+{
+    const char *fn = "body_set_damping";
+    SLOT_OR_FAIL(fn);
+    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", fn);
+    if (!(isfinite(linear) && linear >= 0 && linear <= RANGE_DAMPING_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: linear damping %g is outside [0, 1e6] 1/s", fn, linear);
+    if (!(isfinite(angular) && angular >= 0 && angular <= RANGE_DAMPING_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: angular damping %g is outside [0, 1e6] 1/s", fn, angular);
+    w->bodies.linear_damping[slot] = linear;
+    w->bodies.angular_damping[slot] = angular;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_damping(const carom_world *w, carom_body_id id, double *linear, double *angular)
+{
+    const char *fn = "body_get_damping";
+    SLOT_OR_FAIL(fn);
+    if (!linear && !angular) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: both outputs are NULL", fn);
+    if (linear) *linear = w->bodies.linear_damping[slot];
+    if (angular) *angular = w->bodies.angular_damping[slot];
+    return CAROM_OK;
+}
+
+/* Frame conversions of the body origin frame (as position/orientation). */
+static carom_status convert(const carom_world *w, carom_body_id id, carom_vec3 in, carom_vec3 *out, int to_world,
+                            int is_point, const char *fn)
+{
+    SLOT_OR_FAIL(fn);
+    OUT_OR_FAIL(out, fn);
+    if (!finite_c(in)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: the vector must be finite", fn);
+    xform x = body_xform(&w->bodies, slot);
+    vec3 v = to_v3(in);
+    if (is_point) *out = from_v3(to_world ? xf_point(x, v) : xf_inv_point(x, v));
+    else *out = from_v3(to_world ? q_rotate(x.q, v) : q_inv_rotate(x.q, v));
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_world_point(const carom_world *w, carom_body_id id, carom_vec3 local, carom_vec3 *out)
+{
+    return convert(w, id, local, out, 1, 1, "body_get_world_point");
+}
+CAROM_API carom_status carom_body_get_local_point(const carom_world *w, carom_body_id id, carom_vec3 world, carom_vec3 *out)
+{
+    return convert(w, id, world, out, 0, 1, "body_get_local_point");
+}
+CAROM_API carom_status carom_body_get_world_vector(const carom_world *w, carom_body_id id, carom_vec3 local, carom_vec3 *out)
+{
+    return convert(w, id, local, out, 1, 0, "body_get_world_vector");
+}
+CAROM_API carom_status carom_body_get_local_vector(const carom_world *w, carom_body_id id, carom_vec3 world, carom_vec3 *out)
+{
+    return convert(w, id, world, out, 0, 0, "body_get_local_vector");
+}
+
+CAROM_API carom_status carom_body_get_shape(const carom_world *w, carom_body_id id, carom_shape_def *out)
+{
+    const char *fn = "body_get_shape";
+    SLOT_OR_FAIL(fn);
+    OUT_OR_FAIL(out, fn);
+    const shape *sh = &w->bodies.shapes[slot];
+    carom_shape_def d = carom_shape_sphere(1.0);
+    d.type = (carom_shape_type)sh->type;
+    d.radius = sh->radius;
+    d.half_height = sh->half_height;
+    d.half_extents.x = sh->half_extents.x; d.half_extents.y = sh->half_extents.y; d.half_extents.z = sh->half_extents.z;
+    if (sh->type == SHAPE_HULL) {
+        /* the hull's own vertices, x y z packed: valid while the body lives */
+        d.points = &sh->hull->vertices[0].x;
+        d.point_count = sh->hull->vertex_count;
+    }
+    if (sh->type == SHAPE_PLANE) {
+        d.normal = from_v3(sh->plane_normal);
+        d.offset = sh->plane_offset;
+    }
+    *out = d;
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_previous_position(const carom_world *w, carom_body_id id, carom_vec3 *out)
+{
+    const char *fn = "body_get_previous_position";
+    SLOT_OR_FAIL(fn);
+    OUT_OR_FAIL(out, fn);
+    *out = from_v3(w->bodies.previous_origin[slot]);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_body_get_previous_orientation(const carom_world *w, carom_body_id id, carom_quat *out)
+{
+    const char *fn = "body_get_previous_orientation";
+    SLOT_OR_FAIL(fn);
+    OUT_OR_FAIL(out, fn);
+    quat q = w->bodies.previous_rotation[slot];
+    out->w = q.w; out->x = q.x; out->y = q.y; out->z = q.z;
+    return CAROM_OK;
+}
