@@ -13,7 +13,8 @@ enum {
     BODY_BULLET        = 1u << 2,
     BODY_AWAKE         = 1u << 3,
     BODY_ENABLE_SLEEP  = 1u << 4,
-    BODY_HAS_FORCE     = 1u << 5
+    BODY_HAS_FORCE     = 1u << 5,
+    BODY_SENSOR        = 1u << 6   /* touches nothing; sensor.c reports what overlaps it */
 };
 
 typedef struct body_id_entry {

@@ -328,6 +328,7 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->type[slot] = (int)d.type;
     s->flags[slot] = (d.lock_rotation ? BODY_LOCK_ROTATION : 0) | (d.lock_to_plane ? BODY_LOCK_PLANE : 0) |
                      (d.bullet ? BODY_BULLET : 0) | (d.enable_sleep ? BODY_ENABLE_SLEEP : 0) |
+                     (d.sensor ? BODY_SENSOR : 0) |
                      ((d.awake || !d.enable_sleep) && d.type != CAROM_BODY_STATIC ? BODY_AWAKE : 0);
     s->rotation[slot] = q;
     s->local_center[slot] = mp.center;

@@ -36,6 +36,7 @@ static void add_pair(carom_world *w, int ida, int idb)
     int sa = s->ids[ida].slot, sb = s->ids[idb].slot;
     if (sa < 0 || sb < 0 || ida == idb) return;
     if (s->type[sa] != CAROM_BODY_DYNAMIC && s->type[sb] != CAROM_BODY_DYNAMIC) return;
+    if ((s->flags[sa] | s->flags[sb]) & BODY_SENSOR) return; /* sensors touch nothing (sensor.c) */
     if (!filter_bits_allow(s, sa, sb) || contact_find(&w->contacts, ida, idb) >= 0) return;
     if (w->pair_filter && !w->pair_filter(w->pair_filter_context, world_make_id(w, ida), world_make_id(w, idb))) return;
     int ci = contact_add(&w->contacts, ida, idb);

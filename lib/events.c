@@ -13,6 +13,7 @@ static int push_event(carom_world *w, const carom_contact_event *e, int contact_
     int *children = b->children[b->count];
     children[0] = children[1] = -1;
     b->items[b->count++] = *e;
+    if (contact_index < 0) return 1; /* not from a contact (sensors) */
     const contact *c = &w->contacts.items[contact_index];
     int sa = w->bodies.ids[c->id_a].slot, sb = w->bodies.ids[c->id_b].slot;
     if (sa >= 0 && sb >= 0)
@@ -57,4 +58,15 @@ int events_hit(carom_world *w, int contact_index, int point, double normal_impul
     e.approach_speed = approach_speed;
     e.average_force = impulse_average_force(normal_impulse, dt);
     return push_event(w, &e, contact_index);
+}
+
+int events_sensor(carom_world *w, carom_event_type type, carom_body_id sensor, carom_body_id other, carom_vec3 point)
+{
+    carom_contact_event e;
+    memset(&e, 0, sizeof e);
+    e.type = type;
+    e.a = sensor;
+    e.b = other;
+    e.point = point;
+    return push_event(w, &e, -1);
 }

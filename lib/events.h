@@ -1,5 +1,6 @@
 /* events.h - the contact events of a step, built here and nowhere else: the
- * collision stage reports touches, the solver impacts. */
+ * collision stage reports touches, the solver impacts, the sensor stage
+ * overlaps. */
 #ifndef CAROM_EVENTS_H
 #define CAROM_EVENTS_H
 
@@ -14,5 +15,8 @@ int events_touch(carom_world *w, int contact_index, carom_event_type type);
  * and the approach speed; average force over dt. */
 int events_hit(carom_world *w, int contact_index, int point, double normal_impulse, double tangent_impulse,
                double approach_speed, double dt);
+/* A sensor event (sensor.c): b is the body that began or ended overlapping
+ * sensor a; point its centre of mass (zero when it is gone). */
+int events_sensor(carom_world *w, carom_event_type type, carom_body_id sensor, carom_body_id other, carom_vec3 point);
 
 #endif

@@ -16,6 +16,7 @@
 #include "gjk.h"
 #include "mesh.h"
 #include "narrowphase.h"
+#include "query.h"
 #include "ranges.h"
 #include "shape_def.h"
 #include "world.h"
@@ -34,7 +35,7 @@ static int body_visible(const query_context *q, int id_index)
 {
     const body_store *s = &q->w->bodies;
     int slot = s->ids[id_index].slot;
-    if (slot < 0) return 0;
+    if (slot < 0 || (s->flags[slot] & BODY_SENSOR)) return 0; /* triggers are not in the way */
     if (!q->filter) return 1;
     if (!(s->category[slot] & q->filter->mask)) return 0;
     return !q->filter->fn || q->filter->fn(q->filter->context, world_make_id(q->w, id_index));
@@ -343,6 +344,18 @@ static gjk_result pair_distance(const gjk_proxy *a, const gjk_proxy *b, double r
     r.point_a = v3_madd(p, -0.5 * sep, m.normal);
     r.point_b = v3_madd(p, 0.5 * sep, m.normal);
     return r;
+}
+
+int query_shapes_overlap(const shape *a, xform xa, const shape *b, xform xb)
+{
+    if (a->type == SHAPE_PLANE || is_triangles(a)) { /* the convex one (or a compound) first */
+        const shape *t = a; a = b; b = t;
+        xform tx = xa; xa = xb; xb = tx;
+    }
+    if (a->type == SHAPE_PLANE || is_triangles(a)) return 0;
+    gjk_proxy pa = {a, NULL, 0, {v3_zero(), xa.q}}, pb = {b, NULL, 0, {v3_sub(xb.p, xa.p), xb.q}};
+    gjk_result r = is_convex(a) && is_convex(b) ? gjk_distance(&pa, &pb) : pair_distance(&pa, &pb, 0.0);
+    return r.overlap || r.distance <= 0;
 }
 
 /* ---- input checks ------------------------------------------------------------- */

@@ -68,6 +68,7 @@ static int sweep_against(void *ctx, int id_index)
     const body_store *s = &q->w->bodies;
     int other = s->ids[id_index].slot;
     if (other < 0 || other == q->slot || !filter_bits_allow(s, q->slot, other)) return 1;
+    if ((s->flags[other] | s->flags[q->slot]) & BODY_SENSOR) return 1;
     if (s->type[other] == CAROM_BODY_DYNAMIC && !q->bullet) return 1;
     if (s->type[other] == CAROM_BODY_DYNAMIC && (s->flags[other] & BODY_BULLET)) return 1;
     vec3 delta = v3_sub(q->end, q->start);

@@ -8,6 +8,7 @@
 #include "array.h"
 #include "body_calls.h"
 #include "deferred.h"
+#include "sensor.h"
 #include "world.h"
 #include "ranges.h"
 #include "collision.h"
@@ -193,6 +194,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     impact_memory_free(&s->impact);
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
     free(s->tight_box); free(s->pose); free(s->touching);
+    free(w->sensor_overlaps);
     free(s->new_pairs);
     free(w);
 }
@@ -299,6 +301,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     double t2 = now_ms();
     if (ok) ok = world_collide(w, &ctx);
     if (ok) world_remove_ghost_contacts(w);
+    if (ok) world_pre_solve(w);
     double t3 = now_ms();
     if (ok) {
         ok = world_solve(w, &ctx);
@@ -312,6 +315,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     if (ok && w->def.enable_continuous) world_continuous(w, &ctx);
     double t5 = now_ms();
     if (ok) world_update_sleep(w, &ctx);
+    if (ok) ok = world_update_sensors(w);
     double t6 = now_ms();
 
     w->stats.ms_broadphase = t2 - t1;

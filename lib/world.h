@@ -59,6 +59,10 @@ struct carom_world {
     int in_callback;
     carom_pair_filter_fn *pair_filter; /* carom_world_set_pair_filter (filter.c) */
     void *pair_filter_context;
+    carom_pre_solve_fn *pre_solve;     /* carom_world_set_pre_solve (sensor.c) */
+    void *pre_solve_context;
+    struct sensor_overlap *sensor_overlaps; /* (sensor, other) pairs overlapping after the last step */
+    int sensor_overlap_count, sensor_overlap_capacity;
     char error[WORLD_ERROR_SIZE];
     carom_status last_status;   /* the status world_fail last recorded */
 };

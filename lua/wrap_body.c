@@ -120,7 +120,7 @@ static const char *const body_keys[] = {
     "type", "shape", "position", "velocity", "orientation", "angular_velocity", "mass", "density",
     "restitution", "friction", "bullet", "lock_rotation", "lock_to_plane", "plane_normal", "gravity_scale",
     "damping", "linear_damping", "angular_damping", "sleep", "awake", "user_data", "data",
-    "category", "mask", "group", NULL};
+    "category", "mask", "group", "sensor", NULL};
 
 int clua_world_add_body(lua_State *L)
 {

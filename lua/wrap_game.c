@@ -47,6 +47,7 @@ void clua_read_filter_keys(lua_State *L, int arg, const char *fname, carom_body_
     field_bits(L, arg, fname, "mask", &d->mask);
     int group = d->group;
     if (clua_field_int(L, arg, fname, "group", &group)) d->group = group;
+    clua_field_bool(L, arg, fname, "sensor", &d->sensor);
 }
 
 /* body:set_filter{category=, mask=, group=}: keys left out keep their value. */
@@ -412,16 +413,139 @@ static int body_previous_orientation(lua_State *L)
     return 4;
 }
 
+/* ---- sensors, pre-solve, contacts ---------------------------------------------------- */
+
+static int body_is_sensor(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "is_sensor", &id);
+    lua_pushboolean(L, carom_body_is_sensor(w, id));
+    return 1;
+}
+
+/* body:contacts(): the touching contacts, each {other=, normal=, point=,
+ * separation=, points=, impulse=} (normal from this body to other). */
+static int body_contacts(lua_State *L)
+{
+    carom_body_id id;
+    carom_world *w = game_check_body(L, 1, "contacts", &id);
+    int n = carom_body_get_contacts(w, id, NULL, 0);
+    if (n < 0) n = 0;
+    carom_contact_info *info = lua_newuserdatauv(L, sizeof *info * (size_t)(n > 0 ? n : 1), 0);
+    w = game_check_body(L, 1, "contacts", &id);
+    int got = carom_body_get_contacts(w, id, info, n);
+    if (got > n) got = n;
+    lua_getiuservalue(L, 1, BODY_UV_WORLD);
+    int world_index = lua_gettop(L);
+    lua_createtable(L, got > 0 ? got : 0, 0);
+    for (int i = 0; i < got; i++) {
+        lua_createtable(L, 0, 6);
+        clua_push_body(L, world_index, info[i].other);
+        lua_setfield(L, -2, "other");
+        clua_push_vec3_table(L, info[i].normal);
+        lua_setfield(L, -2, "normal");
+        clua_push_vec3_table(L, info[i].point);
+        lua_setfield(L, -2, "point");
+        lua_pushnumber(L, info[i].separation);
+        lua_setfield(L, -2, "separation");
+        lua_pushinteger(L, info[i].point_count);
+        lua_setfield(L, -2, "points");
+        lua_pushnumber(L, info[i].normal_impulse);
+        lua_setfield(L, -2, "impulse");
+        lua_rawseti(L, -2, i + 1);
+    }
+    return 1;
+}
+
+static const char pre_solve_key = 'p'; /* registry: weak-keyed {world userdata = fn} */
+
+/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids), 4 = manifold. */
+static int dispatch_pre_solve(lua_State *L)
+{
+    const carom_body_id *a = lua_touserdata(L, 2), *b = lua_touserdata(L, 3);
+    const carom_manifold *m = lua_touserdata(L, 4);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
+    lua_pushvalue(L, 1);
+    lua_rawget(L, -2);
+    clua_push_body(L, 1, *a);
+    clua_push_body(L, 1, *b);
+    lua_createtable(L, 0, 3);
+    clua_push_vec3_table(L, m->normal);
+    lua_setfield(L, -2, "normal");
+    lua_createtable(L, m->point_count, 0);
+    lua_createtable(L, m->point_count, 0);
+    for (int i = 0; i < m->point_count; i++) {
+        clua_push_vec3_table(L, m->points[i]);
+        lua_rawseti(L, -3, i + 1);
+        lua_pushnumber(L, m->separations[i]);
+        lua_rawseti(L, -2, i + 1);
+    }
+    lua_setfield(L, -3, "separations");
+    lua_setfield(L, -2, "points");
+    lua_call(L, 3, 1);
+    lua_pushboolean(L, !(lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))); /* only false refuses */
+    return 1;
+}
+
+static int lua_pre_solve(void *context, carom_body_id a, carom_body_id b, const carom_manifold *m)
+{
+    clua_world *lw = context;
+    lua_State *L = lw->stepping;
+    if (!L || lw->callback_failed) return 1;
+    int top = lua_gettop(L);
+    if (!lua_checkstack(L, 12)) return 1;
+    lua_pushcfunction(L, clua_traceback);
+    lua_pushcfunction(L, dispatch_pre_solve);
+    lua_pushvalue(L, 1);
+    lua_pushlightuserdata(L, &a);
+    lua_pushlightuserdata(L, &b);
+    lua_pushlightuserdata(L, (void *)m);
+    int keep = 1;
+    if (lua_pcall(L, 4, 1, top + 1) != LUA_OK) {
+        lw->callback_failed = 1; /* step raises it afterwards, like a contact callback's */
+        lua_setiuservalue(L, 1, WORLD_UV_ERROR);
+    } else {
+        keep = lua_toboolean(L, -1);
+    }
+    lua_settop(L, top);
+    return keep;
+}
+
+/* world:set_pre_solve(fn or nil): fn(a, b, manifold) before each touching
+ * pair is solved; returning false leaves it out of this step. */
+static int world_set_pre_solve(lua_State *L)
+{
+    clua_world *lw = clua_check_world(L, 1, "set_pre_solve");
+    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TFUNCTION) clua_type_error(L, 2, "set_pre_solve", "function or nil");
+    if (lw->stepping) return luaL_error(L, "set_pre_solve: cannot change it inside a contact callback");
+    lua_settop(L, 2);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
+    lua_pushvalue(L, 1);
+    lua_pushvalue(L, 2);
+    lua_rawset(L, -3);
+    lw = clua_check_world(L, 1, "set_pre_solve");
+    carom_world_set_pre_solve(lw->world, lua_isfunction(L, 2) ? lua_pre_solve : NULL, lw);
+    return 0;
+}
+
 void clua_open_game(lua_State *L)
 {
     static const luaL_Reg world_methods[] = {{"ray_cast_all", world_ray_cast_all}, {"shape_cast", world_shape_cast},
-                                             {"overlap", world_overlap}, {"distance", world_distance}, {NULL, NULL}};
+                                             {"overlap", world_overlap}, {"distance", world_distance},
+                                             {"set_pre_solve", world_set_pre_solve}, {NULL, NULL}};
     static const luaL_Reg body_methods[] = {
         {"set_filter", body_set_filter}, {"filter", body_filter}, {"apply_angular_impulse", body_apply_angular_impulse},
         {"set_damping", body_set_damping}, {"damping", body_damping}, {"world_point", body_world_point},
         {"local_point", body_local_point}, {"world_vector", body_world_vector}, {"local_vector", body_local_vector},
         {"shape", body_shape}, {"previous_position", body_previous_position},
-        {"previous_orientation", body_previous_orientation}, {NULL, NULL}};
+        {"previous_orientation", body_previous_orientation}, {"is_sensor", body_is_sensor},
+        {"contacts", body_contacts}, {NULL, NULL}};
+    lua_newtable(L); /* pre-solve functions by world, weak keys: the world's life decides */
+    lua_createtable(L, 0, 1);
+    lua_pushliteral(L, "k");
+    lua_setfield(L, -2, "__mode");
+    lua_setmetatable(L, -2);
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
     luaL_getmetatable(L, CLUA_WORLD_MT);
     lua_getfield(L, -1, "__index");
     luaL_setfuncs(L, world_methods, 0);

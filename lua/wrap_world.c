@@ -17,7 +17,7 @@ int clua_world_add_body(lua_State *L); /* wrap_body.c */
 static const char *const contact_models[] = {"impulse", "penalty", NULL};
 static const char *const corrections[] = {"soft", "baumgarte", "none", NULL};
 static const char *const presets[] = {"fast", "default", "accurate", NULL};
-static const char *const event_names[] = {"begin", "end", "hit"};
+static const char *const event_names[] = {"begin", "end", "hit", "sensor_begin", "sensor_end"};
 
 /* Plain numeric and boolean settings: Lua name -> field of carom_world_def. */
 typedef struct world_field {
@@ -327,6 +327,12 @@ static void push_event(lua_State *L, int world_index, const carom_contact_event 
         carom_world_get_event_children(lw->world, index, &ca, &cb);
         if (ca >= 0) { lua_pushinteger(L, ca + 1); lua_setfield(L, -2, "child_a"); }
         if (cb >= 0) { lua_pushinteger(L, cb + 1); lua_setfield(L, -2, "child_b"); }
+    }
+    if (e->type == CAROM_EVENT_SENSOR_BEGIN || e->type == CAROM_EVENT_SENSOR_END) {
+        lua_getfield(L, -1, "a");
+        lua_setfield(L, -2, "sensor");
+        lua_getfield(L, -1, "b");
+        lua_setfield(L, -2, "other");
     }
 }
 

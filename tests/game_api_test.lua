@@ -211,5 +211,57 @@ test("velocity changes inside a contact callback take effect once, after it", fu
   end)
 end)
 
+test("sensors: sensor_begin / sensor_end with sensor and other, no response", function()
+  local w = carom.world{}
+  local zone = w:add_body{ type = "static", sensor = true, shape = carom.box{ half_extents = {1, 1, 0.5} }, position = {0, 0, 5} }
+  local ball = w:add_body{ shape = carom.sphere{ radius = 0.25 }, position = {0, 0, 8} }
+  assert(zone:is_sensor() and not ball:is_sensor())
+  local seen = {}
+  w:set_contact_callback(function(e)
+    if e.type == "sensor_begin" or e.type == "sensor_end" then
+      assert(e.sensor == zone and e.other == ball)
+      seen[#seen + 1] = e.type
+    end
+  end)
+  w:step(1/60, 90)
+  assert(#seen == 2 and seen[1] == "sensor_begin" and seen[2] == "sensor_end", table.concat(seen, ","))
+  -- free fall through it: z = 8 - g t^2 / 2 to the integrator's O(dt)
+  local _, _, z = ball:position()
+  local t = 1.5
+  assert(math.abs(z - (8 - 9.81 * t * t / 2)) < 0.2, z)
+  local hits = w:ray_cast_all({0, 0, 10}, {0, 0, -20})
+  for _, h in ipairs(hits) do assert(h.body ~= zone, "queries do not see sensors") end
+end)
+
+test("pre-solve: a one-way platform", function()
+  local w = carom.world{}
+  w:add_body{ type = "static", shape = carom.box{ half_extents = {5, 5, 0.5} }, position = {0, 0, -0.5} }
+  local plat = w:add_body{ type = "static", shape = carom.box{ half_extents = {2, 2, 0.1} }, position = {0, 0, 2} }
+  local ball = w:add_body{ shape = carom.sphere{ radius = 0.25 }, position = {0, 0, 0.25}, velocity = {0, 0, 8}, sleep = false }
+  local calls = 0
+  w:set_pre_solve(function(a, b, m)
+    calls = calls + 1
+    assert(m.normal and #m.points >= 1 and #m.separations == #m.points)
+    local other = a == plat and b or a
+    if a ~= plat and b ~= plat then return true end
+    local _, _, z = other:position()
+    return z - 0.25 >= 2.05 -- false while it comes up through
+  end)
+  w:step(1/60, 240)
+  local _, _, z = ball:position()
+  near(z, 2.35, 0.01, "resting on the platform")
+  assert(calls > 0)
+  local cs = ball:contacts()
+  assert(#cs == 1 and cs[1].other == plat and math.abs(cs[1].normal[3] + 1) < 1e-9)
+  near(cs[1].impulse, ball:mass() * 9.81 / 60, 0.01 * ball:mass() * 9.81 / 60, "m g dt")
+  -- an error in it is raised by step, a table as itself
+  w:set_pre_solve(function() error({ why = "no" }) end)
+  local ok, err = pcall(w.step, w, 1/60)
+  assert(not ok and type(err) == "table" and err.why == "no")
+  w:set_pre_solve(nil)
+  w:step(1/60)
+  raises("function or nil", w.set_pre_solve, w, 3)
+end)
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

@@ -378,6 +378,11 @@ typedef struct carom_body_def {
     uint64_t category;             /* 1 */
     uint64_t mask;                 /* CAROM_MASK_ALL */
     int group;                     /* 0 */
+    int sensor;                    /* 0: 1 makes the body a sensor: it touches nothing (no contacts,
+                                      no response) and reports SENSOR_BEGIN/END events for the
+                                      bodies its filter allows as they start and stop overlapping it
+                                      at the end of a step (static and sleeping ones included, other
+                                      sensors not; a body crossing it within one step is not seen) */
 } carom_body_def;
 
 #define CAROM_MASK_ALL UINT64_MAX
@@ -413,6 +418,7 @@ static inline carom_body_def carom_body_def_default(void)
     d.category = 1;
     d.mask = CAROM_MASK_ALL;
     d.group = 0;
+    d.sensor = 0;
     return d;
 }
 
@@ -468,7 +474,9 @@ CAROM_API carom_status carom_body_get_kinetic_energy(const carom_world *world, c
 typedef enum carom_event_type {
     CAROM_EVENT_BEGIN = 0,   /* two bodies started touching */
     CAROM_EVENT_END = 1,     /* they stopped touching */
-    CAROM_EVENT_HIT = 2      /* an impact: approach speed above the restitution threshold */
+    CAROM_EVENT_HIT = 2,     /* an impact: approach speed above the restitution threshold */
+    CAROM_EVENT_SENSOR_BEGIN = 3, /* body b started overlapping sensor a (see carom_body_def.sensor) */
+    CAROM_EVENT_SENSOR_END = 4    /* b stopped overlapping sensor a (or was destroyed: b is then stale) */
 } carom_event_type;
 
 struct carom_contact_event {
@@ -685,6 +693,38 @@ CAROM_API carom_status carom_body_get_shape(const carom_world *world, carom_body
 CAROM_API carom_status carom_body_get_previous_position(const carom_world *world, carom_body_id id, carom_vec3 *out);
 CAROM_API carom_status carom_body_get_previous_orientation(const carom_world *world, carom_body_id id,
                                                            carom_quat *out);
+
+
+/* ---- sensors and contact control ---------------------------------------- */
+
+CAROM_API int carom_body_is_sensor(const carom_world *world, carom_body_id id);
+
+/* The touching manifold handed to a pre-solve callback. */
+typedef struct carom_manifold {
+    carom_vec3 normal;            /* unit, from a to b */
+    int point_count;              /* 1..4 */
+    carom_vec3 points[4];         /* world points */
+    double separations[4];        /* < 0: overlapping */
+} carom_manifold;
+/* Called during the step for each touching pair (neither a sensor) before
+ * it is solved, with the world locked; return 0 to leave the pair out of
+ * this step (no response, no impulses kept): one-way platforms, ghosts.
+ * Begin/end events still follow the touching state. */
+typedef int carom_pre_solve_fn(void *context, carom_body_id a, carom_body_id b, const carom_manifold *manifold);
+CAROM_API carom_status carom_world_set_pre_solve(carom_world *world, carom_pre_solve_fn *fn, void *context);
+
+typedef struct carom_contact_info {
+    carom_body_id other;
+    carom_vec3 normal;            /* unit, from the body asked about towards other */
+    carom_vec3 point;             /* the deepest point of the manifold */
+    double separation;            /* of that point (< 0 overlapping) */
+    int point_count;
+    double normal_impulse;        /* summed over the points, last step (N s); 0 if not solved */
+} carom_contact_info;
+/* The body's touching contacts: fills up to capacity and returns the total
+ * count; -1 on bad input. */
+CAROM_API int carom_body_get_contacts(const carom_world *world, carom_body_id id, carom_contact_info *contacts,
+                                      int capacity);
 
 #ifdef __cplusplus
 }
