@@ -18,10 +18,6 @@
 #include "sensor.h"
 #include "world.h"
 
-typedef struct sensor_overlap {
-    carom_body_id sensor, other;
-} sensor_overlap;
-
 static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
 
 CAROM_API int carom_body_is_sensor(const carom_world *w, carom_body_id id)

@@ -393,7 +393,8 @@ static int read_shape(reader *r, shape *s, int body_type)
 
 /* ---- the snapshot ------------------------------------------------------------------- */
 
-#define BODY_KNOWN_FLAGS (BODY_LOCK_ROTATION | BODY_LOCK_PLANE | BODY_BULLET | BODY_AWAKE | BODY_ENABLE_SLEEP | BODY_HAS_FORCE)
+#define BODY_KNOWN_FLAGS (BODY_LOCK_ROTATION | BODY_LOCK_PLANE | BODY_BULLET | BODY_AWAKE | BODY_ENABLE_SLEEP | BODY_HAS_FORCE | \
+                          BODY_SENSOR)
 #define CONTACT_KNOWN_FLAGS \
     (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_SIM | CONTACT_REUSABLE | CONTACT_APART | CONTACT_ANY_TOUCHING)
 
@@ -436,6 +437,11 @@ static void write_world(writer *o, const carom_world *w)
         put_f64(o, s->sleep_time[i]);
         put_v3(o, s->fat_box[i].lo);
         put_v3(o, s->fat_box[i].hi);
+        put_u64(o, s->category[i]);
+        put_u64(o, s->filter_mask[i]);
+        put_i32(o, s->group[i]);
+        put_v3(o, s->previous_origin[i]);
+        put_q(o, s->previous_rotation[i]);
         write_shape(o, &s->shapes[i]);
     }
 
@@ -472,6 +478,12 @@ static void write_world(writer *o, const carom_world *w)
         }
         put_v3(o, d->tangent1);
         put_v3(o, d->normal_a);
+    }
+    /* the sensors' overlaps after the last step (sensor.c): their next events */
+    put_i32(o, w->sensor_overlap_count);
+    for (int i = 0; i < w->sensor_overlap_count; i++) {
+        put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].sensor));
+        put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].other));
     }
 }
 
@@ -587,6 +599,11 @@ static int read_bodies(reader *r, carom_world *w)
         s->sleep_time[i] = get_f64(r, what);
         s->fat_box[i].lo = get_v3(r, what);
         s->fat_box[i].hi = get_v3(r, what);
+        s->category[i] = get_u64(r, what);
+        s->filter_mask[i] = get_u64(r, what);
+        s->group[i] = get_i32(r, what);
+        s->previous_origin[i] = get_v3(r, what);
+        s->previous_rotation[i] = get_q(r, what);
         s->user_data[i] = NULL;
         s->proxy[i] = -1;
         if (r->failed) return 0;
@@ -625,6 +642,29 @@ static int read_bodies(reader *r, carom_world *w)
         s->inv_inertia_local[i] = dynamic ? m3_inverse(s->inertia_local[i]) : m3_zero();
         body_update_inertia(s, i);
     }
+    return 1;
+}
+
+/* (sensor.c's pairs: a sensor id and another, two packed ids each) */
+static int read_sensor_overlaps(reader *r, carom_world *w)
+{
+    int count = get_count(r, 16, 1 << 28, "sensor overlap count");
+    if (r->failed) return 0;
+    if (count == 0) return 1;
+    sensor_overlap *pairs = malloc(sizeof *pairs * (size_t)count);
+    if (!pairs) return bad(r, "out of memory");
+    for (int i = 0; i < count; i++) {
+        pairs[i].sensor = carom_body_id_unpack(get_u64(r, "sensor overlap"));
+        pairs[i].other = carom_body_id_unpack(get_u64(r, "sensor overlap"));
+        if (!r->failed && !carom_body_is_sensor(w, pairs[i].sensor)) {
+            free(pairs);
+            return bad(r, "sensor overlap %d names a body that is not a live sensor", i);
+        }
+    }
+    if (r->failed) { free(pairs); return 0; }
+    w->sensor_overlaps = pairs;
+    w->sensor_overlap_count = count;
+    w->sensor_overlap_capacity = count;
     return 1;
 }
 
@@ -720,13 +760,13 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (!w) return bad(&r, "out of memory"), NULL;
     w->def.body_capacity = capacity_hint;
     w->stats.step_count = (long long)steps;
-    if (!read_bodies(&r, w) || !read_contacts(&r, w)) {
+    if (!read_bodies(&r, w) || !read_contacts(&r, w) || !read_sensor_overlaps(&r, w)) {
         carom_world_destroy(w);
         return NULL;
     }
     if (r.pos != size) {
         carom_world_destroy(w);
-        return bad(&r, "%zu bytes left over after the contacts", size - r.pos), NULL;
+        return bad(&r, "%zu bytes left over after the sensor overlaps", size - r.pos), NULL;
     }
     /* the broadphase, rebuilt from the stored bounds in slot order, with the moved set restored */
     body_store *s = &w->bodies;

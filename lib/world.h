@@ -47,6 +47,11 @@ typedef struct step_scratch {
     int deferred_op_count, deferred_op_capacity;
 } step_scratch;
 
+/* A sensor and a body overlapping it after the last step (sensor.c). */
+typedef struct sensor_overlap {
+    carom_body_id sensor, other;
+} sensor_overlap;
+
 struct carom_world {
     carom_world_def def;
     body_store bodies;
@@ -61,7 +66,7 @@ struct carom_world {
     void *pair_filter_context;
     carom_pre_solve_fn *pre_solve;     /* carom_world_set_pre_solve (sensor.c) */
     void *pre_solve_context;
-    struct sensor_overlap *sensor_overlaps; /* (sensor, other) pairs overlapping after the last step */
+    sensor_overlap *sensor_overlaps; /* sorted by sensor, then other */
     int sensor_overlap_count, sensor_overlap_capacity;
     char error[WORLD_ERROR_SIZE];
     carom_status last_status;   /* the status world_fail last recorded */
