@@ -582,6 +582,7 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
  * OUT_OF_MEMORY; the last error says why): *out is the new body's id, or the
  * null id on failure. */
 CAROM_API carom_status carom_body_try_create(carom_world *world, const carom_body_def *def, carom_body_id *out);
+
 /* ---- filtering and game queries ---------------------------------------- */
 
 /* The filter bits of a body (see carom_body_def). Changing them drops the
