@@ -1,6 +1,6 @@
 # fuzz/fuzz.mk - libFuzzer harnesses (included by the Makefile).
 #   make fuzz [FUZZ_SECONDS=60] [FUZZ_JOBS=1]   build with clang and run each harness
-#   make fuzz-smoke                              each for a few seconds (CI)
+#   make fuzz-smoke                              each for 300 inputs from seed 1 (CI: the same on every machine)
 #   make check-fuzz-replay                       the seed corpus and every past crash through
 #                                                the harnesses, built with $(CC) (part of make check)
 # Harnesses: api (C call sequences), scene (random scenes), lua (random
@@ -10,6 +10,10 @@
 FUZZ_CC      ?= clang
 FUZZ_SECONDS ?= 60
 FUZZ_SMOKE   ?= 15
+# A fixed seed and a fixed number of inputs make the smoke run the same on every
+# machine (a time limit alone would let a faster CI machine reach other inputs).
+FUZZ_SMOKE_RUNS ?= 300
+FUZZ_LIMIT    = -max_total_time=$(FUZZ_SECONDS)
 FUZZ_NAMES   := api scene lua snapshot
 FUZZ_DIR     := build/fuzz-clang
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all
@@ -45,7 +49,7 @@ fuzz: fuzz-build
 	    mkdir -p $(FUZZ_DIR)/corpus/$$n $(FUZZ_DIR)/artifacts/$$n fuzz/corpus/$$n; \
 	    echo "== fuzz_$$n for $(FUZZ_SECONDS) s"; \
 	    log=$(FUZZ_DIR)/fuzz_$$n.log; \
-	    if ! ./$(FUZZ_DIR)/fuzz_$$n -max_total_time=$(FUZZ_SECONDS) -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
+	    if ! ./$(FUZZ_DIR)/fuzz_$$n $(FUZZ_LIMIT) -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
 	        -print_final_stats=1 -artifact_prefix=$(FUZZ_DIR)/artifacts/$$n/ \
 	        $(FUZZ_DIR)/corpus/$$n fuzz/corpus/$$n > $$log 2>&1; then \
 	        tail -40 $$log; echo "fuzz_$$n: crash, input saved in $(FUZZ_DIR)/artifacts/$$n/"; exit 1; fi; \
@@ -53,7 +57,9 @@ fuzz: fuzz-build
 	done; echo "make fuzz: no crash"
 
 fuzz-smoke:
-	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_SMOKE)
+	rm -rf $(FUZZ_DIR)/corpus
+	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_SMOKE) \
+	    FUZZ_LIMIT='-seed=1 -runs=$(FUZZ_SMOKE_RUNS) -max_total_time=600'
 
 # The harnesses as plain programs over files (fuzz/replay.c is their main).
 $(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c $(STATIC) $(wildcard fuzz/*.h) $(LUA_SRC)
