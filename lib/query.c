@@ -417,7 +417,7 @@ static int find_candidates(const carom_world *w, aabb box, candidate_list *l)
     memset(l, 0, sizeof *l);
     bp_query(w->bp, box, collect_candidate, l);
     if (l->failed) { free(l->items); l->items = NULL; return 0; }
-    qsort(l->items, (size_t)l->count, sizeof *l->items, compare_int);
+    if (l->count > 1) qsort(l->items, (size_t)l->count, sizeof *l->items, compare_int);
     return 1;
 }
 
@@ -539,7 +539,7 @@ CAROM_API int carom_world_ray_cast_all(const carom_world *w, carom_vec3 origin, 
         free(h.items);
         return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "ray_cast_all: out of memory"), -1;
     }
-    qsort(h.items, (size_t)h.count, sizeof *h.items, compare_hits);
+    if (h.count > 1) qsort(h.items, (size_t)h.count, sizeof *h.items, compare_hits);
     for (int i = 0; i < h.count && i < capacity; i++) hits[i] = h.items[i];
     free(h.items);
     return h.count;

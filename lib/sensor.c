@@ -137,7 +137,7 @@ int world_update_sensors(carom_world *w)
     }
     if (q.failed) { free(q.found); return 0; }
     if (q.count == 0 && w->sensor_overlap_count == 0) { free(q.found); return 1; }
-    qsort(q.found, (size_t)q.count, sizeof *q.found, compare_overlaps);
+    if (q.count > 1) qsort(q.found, (size_t)q.count, sizeof *q.found, compare_overlaps);
     /* merge the sorted old and new sets: only in new = begin, only in old = end
      * (unless the sensor itself is gone) */
     const sensor_overlap *old = w->sensor_overlaps;
