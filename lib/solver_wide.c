@@ -92,7 +92,16 @@ static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint 
     wb->impulse_scale[l] = c->soft.impulse_scale;
 }
 
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
+/* Per colour and point count: manifolds counted, then lanes filled, and the first batch. */
+typedef struct plan_buckets {
+    int count[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+    int start[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+} plan_buckets;
+
+/* The set, its batches and points and the planner's scratch in one block
+ * (grown, never shrunk), 64-byte aligned. */
+static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constraint *cc, int ncon, int nb,
+                             int **color, uint32_t **used)
 {
     /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
     int max_batches = ncon / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
@@ -119,14 +128,18 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
     base += align_up(sizeof(wide_point) * (size_t)max_wide_points);
     ws->overflow = (int *)base;
     base += align_up(sizeof(int) * (size_t)ncon);
-    int *color = (int *)base;
+    *color = (int *)base;
     base += align_up(sizeof(int) * (size_t)ncon);
-    uint32_t *used = (uint32_t *)base;
-    memset(used, 0, sizeof *used * (size_t)nb);
+    *used = (uint32_t *)base;
+    memset(*used, 0, sizeof **used * (size_t)nb);
+    return ws;
+}
 
-    /* greedy colouring; the static body 0 never blocks (it does not move) */
-    int bucket[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
-    memset(bucket, 0, sizeof bucket);
+/* Greedy colouring; the static body 0 never blocks (it does not move). */
+static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int *color, uint32_t *used,
+                            plan_buckets *pb)
+{
+    memset(pb->count, 0, sizeof pb->count);
     ws->overflow_count = 0;
     for (int k = 0; k < ncon; k++) {
         int a = cc[k].a, b = cc[k].b;
@@ -142,19 +155,22 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
         color[k] = c;
         if (a) used[a] |= 1u << c;
         if (b) used[b] |= 1u << c;
-        bucket[c][cc[k].count]++;
+        pb->count[c][cc[k].count]++;
     }
-    /* batches in colour order; inside a colour, by point count */
-    int start[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+}
+
+/* Batches in colour order; inside a colour, by point count. */
+static void lay_out_batches(wide_set *ws, plan_buckets *pb)
+{
     int nbatch = 0, nwide = 0;
     for (int c = 0; c < WIDE_COLORS; c++)
         for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
-            start[c][n] = nbatch;
-            int batches = (bucket[c][n] + LANES - 1) / LANES;
+            pb->start[c][n] = nbatch;
+            int batches = (pb->count[c][n] + LANES - 1) / LANES;
             for (int i = 0; i < batches; i++) {
                 wide_batch *wb = &ws->batches[nbatch + i];
                 int first = nwide + i * n;
-                if (i == batches - 1 && bucket[c][n] % LANES) {
+                if (i == batches - 1 && pb->count[c][n] % LANES) {
                     /* the part-full batch: empty lanes stay zero (no mass, no effect) */
                     memset(wb, 0, sizeof *wb);
                     memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
@@ -164,19 +180,36 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
             }
             nbatch += batches;
             nwide += batches * n;
-            bucket[c][n] = 0; /* now: lanes filled so far */
+            pb->count[c][n] = 0; /* now: lanes filled so far */
         }
+    ws->batch_count = nbatch;
+}
+
+/* Each coloured manifold into the next free lane of its bucket's batches. */
+static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int *color, plan_buckets *pb)
+{
     for (int k = 0; k < ncon; k++) {
         int c = color[k];
         if (c < 0) continue;
-        int n = cc[k].count, slot = bucket[c][n]++;
-        wide_batch *wb = &ws->batches[start[c][n] + slot / LANES];
+        int n = cc[k].count, slot = pb->count[c][n]++;
+        wide_batch *wb = &ws->batches[pb->start[c][n] + slot / LANES];
         fill_header(wb, slot % LANES, k, &cc[k]);
         wb->lanes = slot % LANES + 1;
-        cc[k].wide_batch = start[c][n] + slot / LANES;
+        cc[k].wide_batch = pb->start[c][n] + slot / LANES;
         cc[k].wide_lane = slot % LANES;
     }
-    ws->batch_count = nbatch;
+}
+
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
+{
+    int *color;
+    uint32_t *used;
+    wide_set *ws = reserve_set(mem, capacity, cc, ncon, nb, &color, &used);
+    if (!ws) return NULL;
+    plan_buckets pb;
+    color_manifolds(ws, cc, ncon, color, used, &pb);
+    lay_out_batches(ws, &pb);
+    fill_lanes(ws, cc, ncon, color, &pb);
 #if WIDE_AVX2
     /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
     ws->avx2 = __builtin_cpu_supports("avx2") != 0 && !getenv("CAROM_NO_AVX2");
@@ -267,17 +300,16 @@ LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body 
     scatter(wb, bodies, &lb);
 }
 
-/* The scalar contact_solve (contact_solver.c), four manifolds at a time. */
-LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_context *ctx, int use_bias,
-                             int hold_bounces)
+/* The lanes' position and rotation changes since the sub-steps began: dp the
+ * relative translation (B minus A), dqa and dqb each body's rotation. */
+LANE_INLINE void gather_motion(const wide_batch *wb, const step_context *ctx, lane_t dp[3], lane_t dqa[3],
+                               lane_t dqb[3])
 {
-    lane_bodies lb;
-    gather(wb, ctx->bodies, &lb);
     const vec3 *pa0 = &ctx->dp[wb->a[0]], *pa1 = &ctx->dp[wb->a[1]], *pa2 = &ctx->dp[wb->a[2]], *pa3 = &ctx->dp[wb->a[3]];
     const vec3 *pb0 = &ctx->dp[wb->b[0]], *pb1 = &ctx->dp[wb->b[1]], *pb2 = &ctx->dp[wb->b[2]], *pb3 = &ctx->dp[wb->b[3]];
     const vec3 *qa0 = &ctx->dq[wb->a[0]], *qa1 = &ctx->dq[wb->a[1]], *qa2 = &ctx->dq[wb->a[2]], *qa3 = &ctx->dq[wb->a[3]];
     const vec3 *qb0 = &ctx->dq[wb->b[0]], *qb1 = &ctx->dq[wb->b[1]], *qb2 = &ctx->dq[wb->b[2]], *qb3 = &ctx->dq[wb->b[3]];
-    lane_t dpa[3], dp[3], dqa[3], dqb[3];
+    lane_t dpa[3];
     SET_LANES(dpa[0], pa0, pa1, pa2, pa3, x);
     SET_LANES(dpa[1], pa0, pa1, pa2, pa3, y);
     SET_LANES(dpa[2], pa0, pa1, pa2, pa3, z);
@@ -291,6 +323,14 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_c
     SET_LANES(dqb[0], qb0, qb1, qb2, qb3, x);
     SET_LANES(dqb[1], qb0, qb1, qb2, qb3, y);
     SET_LANES(dqb[2], qb0, qb1, qb2, qb3, z);
+}
+
+/* The normal rows of every point of a batch (contact_solve's first loop). */
+LANE_INLINE void solve_normal_rows(const wide_batch *wb, wide_point *pts, const step_context *ctx, lane_bodies *lb,
+                                   int use_bias, int hold_bounces)
+{
+    lane_t dp[3], dqa[3], dqb[3];
+    gather_motion(wb, ctx, dp, dqa, dqb);
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(ctx->inv_h), push = SPLAT(-ctx->push_max);
     /* bias, mass and impulse scales of a penetrating point (speculative ones differ per lane below) */
     lane_t pen_mass_scale = one, pen_impulse_scale = zero;
@@ -316,8 +356,8 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_c
         lane_t bias = SELECT_LANES(ahead, spec, pen_bias);
         lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
         lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
-        lane_t vn = wb->n[0] * (lb.vb[0] - lb.va[0]) + wb->n[1] * (lb.vb[1] - lb.va[1]) + wb->n[2] * (lb.vb[2] - lb.va[2]) +
-                    DOT3(lb.wb, p->rb_n) - DOT3(lb.wa, p->ra_n);
+        lane_t vn = wb->n[0] * (lb->vb[0] - lb->va[0]) + wb->n[1] * (lb->vb[1] - lb->va[1]) +
+                    wb->n[2] * (lb->vb[2] - lb->va[2]) + DOT3(lb->wb, p->rb_n) - DOT3(lb->wa, p->ra_n);
         lane_t old = p->normal_impulse;
         lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
         total = LANE_MAX(total, zero);
@@ -330,44 +370,57 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_c
         p->total_normal_impulse += lambda;
         lane_t most = p->max_normal_impulse;
         p->max_normal_impulse = LANE_MAX(most, total);
-        lane_t la = lb.ma * lambda, lbm = lb.mb * lambda;
+        lane_t la = lb->ma * lambda, lbm = lb->mb * lambda;
         for (int d = 0; d < 3; d++) {
-            lb.va[d] -= la * wb->n[d];
-            lb.wa[d] -= lambda * p->ia_n[d];
-            lb.vb[d] += lbm * wb->n[d];
-            lb.wb[d] += lambda * p->ib_n[d];
+            lb->va[d] -= la * wb->n[d];
+            lb->wa[d] -= lambda * p->ia_n[d];
+            lb->vb[d] += lbm * wb->n[d];
+            lb->wb[d] += lambda * p->ib_n[d];
         }
     }
-    if (ctx->friction) {
-        for (int i = 0; i < wb->count; i++) {
-            wide_point *p = &pts[i];
-            lane_t dv[3] = {lb.vb[0] - lb.va[0], lb.vb[1] - lb.va[1], lb.vb[2] - lb.va[2]};
-            lane_t v1 = DOT3(dv, wb->t1) + DOT3(lb.wb, p->rb_t[0]) - DOT3(lb.wa, p->ra_t[0]);
-            lane_t v2 = DOT3(dv, wb->t2) + DOT3(lb.wb, p->rb_t[1]) - DOT3(lb.wa, p->ra_t[1]);
-            lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-            lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-            /* Coulomb's cone (coulomb_factor): scale back to |t| <= mu * normal */
-            lane_t limit = wb->friction * p->normal_impulse;
-            lane_t mag2 = n1 * n1 + n2 * n2;
-            lane_mask over = mag2 > limit * limit;
-            if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
-                lane_t f;
-                for (int l = 0; l < LANES; l++) f[l] = coulomb_factor(mag2[l], limit[l]);
-                n1 *= f;
-                n2 *= f;
-            }
-            p->tangent_impulse[0] = n1;
-            p->tangent_impulse[1] = n2;
-            lane_t d1 = n1 - o1, d2 = n2 - o2;
-            for (int d = 0; d < 3; d++) {
-                lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
-                lb.va[d] -= lb.ma * P;
-                lb.vb[d] += lb.mb * P;
-                lb.wa[d] -= p->ia_t[0][d] * d1 + p->ia_t[1][d] * d2;
-                lb.wb[d] += p->ib_t[0][d] * d1 + p->ib_t[1][d] * d2;
-            }
+}
+
+/* The friction rows of every point of a batch (contact_solve's second loop). */
+LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane_bodies *lb)
+{
+    for (int i = 0; i < wb->count; i++) {
+        wide_point *p = &pts[i];
+        lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
+        lane_t v1 = DOT3(dv, wb->t1) + DOT3(lb->wb, p->rb_t[0]) - DOT3(lb->wa, p->ra_t[0]);
+        lane_t v2 = DOT3(dv, wb->t2) + DOT3(lb->wb, p->rb_t[1]) - DOT3(lb->wa, p->ra_t[1]);
+        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
+        /* Coulomb's cone (coulomb_factor): scale back to |t| <= mu * normal */
+        lane_t limit = wb->friction * p->normal_impulse;
+        lane_t mag2 = n1 * n1 + n2 * n2;
+        lane_mask over = mag2 > limit * limit;
+        if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
+            lane_t f;
+            for (int l = 0; l < LANES; l++) f[l] = coulomb_factor(mag2[l], limit[l]);
+            n1 *= f;
+            n2 *= f;
+        }
+        p->tangent_impulse[0] = n1;
+        p->tangent_impulse[1] = n2;
+        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        for (int d = 0; d < 3; d++) {
+            lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
+            lb->va[d] -= lb->ma * P;
+            lb->vb[d] += lb->mb * P;
+            lb->wa[d] -= p->ia_t[0][d] * d1 + p->ia_t[1][d] * d2;
+            lb->wb[d] += p->ib_t[0][d] * d1 + p->ib_t[1][d] * d2;
         }
     }
+}
+
+/* The scalar contact_solve (contact_solver.c), four manifolds at a time. */
+LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_context *ctx, int use_bias,
+                             int hold_bounces)
+{
+    lane_bodies lb;
+    gather(wb, ctx->bodies, &lb);
+    solve_normal_rows(wb, pts, ctx, &lb, use_bias, hold_bounces);
+    if (ctx->friction) solve_friction_rows(wb, pts, &lb);
     scatter(wb, ctx->bodies, &lb);
 }
 
@@ -413,102 +466,139 @@ LANE_INLINE void gather_vec(lane_t out[3], vec3 v0, vec3 v1, vec3 v2, vec3 v3_)
     memcpy(&out[2], z, sizeof out[2]);
 }
 
+/* What every point of a batch's manifolds shares: the lanes' constraints,
+ * bodies (inverse masses and inertias, velocities) and centres of mass. */
+typedef struct lane_manifolds {
+    contact_constraint *c[LANES];
+    lane_t ia[3][3], ib[3][3], va[3], wa[3], vb[3], wb[3], ma, mb, center_a[3], center_b[3];
+} lane_manifolds;
+
+LANE_INLINE void gather_manifolds(const wide_batch *wb, contact_constraint *cc, const impulse_body *bodies,
+                                  lane_manifolds *lm)
+{
+    const impulse_body *A[LANES], *B[LANES];
+    vec3 ca[LANES], cb[LANES];
+    for (int l = 0; l < LANES; l++) {
+        lm->c[l] = l < wb->lanes ? &cc[wb->con[l]] : NULL;
+        A[l] = &bodies[wb->a[l]];
+        B[l] = &bodies[wb->b[l]];
+        ca[l] = lm->c[l] ? lm->c[l]->center_a : v3_zero();
+        cb[l] = lm->c[l] ? lm->c[l]->center_b : v3_zero();
+    }
+    gather_inertia(lm->ia, A[0], A[1], A[2], A[3]);
+    gather_inertia(lm->ib, B[0], B[1], B[2], B[3]);
+    gather_vec(lm->va, A[0]->v, A[1]->v, A[2]->v, A[3]->v);
+    gather_vec(lm->wa, A[0]->w, A[1]->w, A[2]->w, A[3]->w);
+    gather_vec(lm->vb, B[0]->v, B[1]->v, B[2]->v, B[3]->v);
+    gather_vec(lm->wb, B[0]->w, B[1]->w, B[2]->w, B[3]->w);
+    SET_LANES(lm->ma, A[0], A[1], A[2], A[3], inv_mass);
+    SET_LANES(lm->mb, B[0], B[1], B[2], B[3], inv_mass);
+    gather_vec(lm->center_a, ca[0], ca[1], ca[2], ca[3]);
+    gather_vec(lm->center_b, cb[0], cb[1], cb[2], cb[3]);
+}
+
+/* A point's rows: the arms crossed with the basis, those through the inverse
+ * inertias, and the effective masses as solver.c:
+ * 1 / (1/mA + 1/mB + (IA^-1 (rA x n)).(rA x n) + ...) */
+LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wide_point *p, const lane_t ra[3],
+                              const lane_t rb[3])
+{
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
+    const lane_t mab = lm->ma + lm->mb;
+    CROSS(p->ra_n, ra, wb->n);
+    CROSS(p->rb_n, rb, wb->n);
+    MAT_VEC(p->ia_n, lm->ia, p->ra_n);
+    MAT_VEC(p->ib_n, lm->ib, p->rb_n);
+    CROSS(p->ra_t[0], ra, wb->t1);
+    CROSS(p->rb_t[0], rb, wb->t1);
+    CROSS(p->ra_t[1], ra, wb->t2);
+    CROSS(p->rb_t[1], rb, wb->t2);
+    for (int q = 0; q < 2; q++) {
+        MAT_VEC(p->ia_t[q], lm->ia, p->ra_t[q]);
+        MAT_VEC(p->ib_t[q], lm->ib, p->rb_t[q]);
+    }
+    lane_t kn = mab + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
+    lane_t k1 = mab + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
+    lane_t k2 = mab + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
+    lane_t ikn = one / SELECT_LANES(kn > zero, kn, one), ik1 = one / SELECT_LANES(k1 > zero, k1, one),
+           ik2 = one / SELECT_LANES(k2 > zero, k2, one);
+    p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
+    p->tangent_mass[0] = SELECT_LANES(k1 > zero, ik1, zero);
+    p->tangent_mass[1] = SELECT_LANES(k2 > zero, ik2, zero);
+}
+
+/* Point i's warm-start impulses, scaled by warm (empty lanes read zeros). */
+LANE_INLINE void warm_point(wide_point *p, const contact_point_state *const st[LANES], double warm)
+{
+    const lane_t zero = SPLAT(0.0), warm_scale = SPLAT(warm);
+    lane_t ni, t1, t2;
+    SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
+    SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
+    SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
+    p->normal_impulse = warm_scale * ni;
+    p->tangent_impulse[0] = warm_scale * t1;
+    p->tangent_impulse[1] = warm_scale * t2;
+    p->total_normal_impulse = zero;
+    p->max_normal_impulse = zero;
+}
+
+/* The scalar copy of point i in each lane's constraint (restitution, impulse
+ * storage and the overflow passes read it); returns the deepest penetration. */
+LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, const wide_point *p, int i,
+                               const lane_t ra[3], const lane_t rb[3], const lane_t *sep, const lane_t *vn,
+                               double deepest)
+{
+    for (int l = 0; l < wb->lanes; l++) {
+        constraint_point *cold = &lm->c[l]->p[i];
+        double s = (*sep)[l];
+        cold->relative_velocity = contact_approach_velocity((*vn)[l], lm->c[l]->gravity_closing, s);
+        cold->base_separation = s;
+        cold->total_normal_impulse = 0.0;
+        cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
+        cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
+        cold->normal_mass = p->normal_mass[l];
+        cold->tangent_mass[0] = p->tangent_mass[0][l];
+        cold->tangent_mass[1] = p->tangent_mass[1][l];
+        if (-s > deepest) deepest = -s;
+    }
+    return deepest;
+}
+
 LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_constraint *cc,
                                  const impulse_body *bodies, double warm)
 {
     static const manifold_point no_point = {{0, 0, 0}, 0, 0};
     static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
-    const impulse_body *A[LANES], *B[LANES];
-    contact_constraint *c[LANES];
-    vec3 ca[LANES], cb[LANES];
-    for (int l = 0; l < LANES; l++) {
-        c[l] = l < wb->lanes ? &cc[wb->con[l]] : NULL;
-        A[l] = &bodies[wb->a[l]];
-        B[l] = &bodies[wb->b[l]];
-        ca[l] = c[l] ? c[l]->center_a : v3_zero();
-        cb[l] = c[l] ? c[l]->center_b : v3_zero();
-    }
-    lane_t ia[3][3], ib[3][3], lb_va[3], lb_wa[3], lb_vb[3], lb_wb[3], ma, mb, center_a[3], center_b[3];
-    gather_inertia(ia, A[0], A[1], A[2], A[3]);
-    gather_inertia(ib, B[0], B[1], B[2], B[3]);
-    gather_vec(lb_va, A[0]->v, A[1]->v, A[2]->v, A[3]->v);
-    gather_vec(lb_wa, A[0]->w, A[1]->w, A[2]->w, A[3]->w);
-    gather_vec(lb_vb, B[0]->v, B[1]->v, B[2]->v, B[3]->v);
-    gather_vec(lb_wb, B[0]->w, B[1]->w, B[2]->w, B[3]->w);
-    SET_LANES(ma, A[0], A[1], A[2], A[3], inv_mass);
-    SET_LANES(mb, B[0], B[1], B[2], B[3], inv_mass);
-    gather_vec(center_a, ca[0], ca[1], ca[2], ca[3]);
-    gather_vec(center_b, cb[0], cb[1], cb[2], cb[3]);
-    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), warm_scale = SPLAT(warm);
-    const lane_t mab = ma + mb;
+    lane_manifolds lm;
+    gather_manifolds(wb, cc, bodies, &lm);
     double deepest = 0.0;
     for (int i = 0; i < wb->count; i++) {
         wide_point *p = &pts[i];
         const manifold_point *mp[LANES];
         const contact_point_state *st[LANES];
         for (int l = 0; l < LANES; l++) {
-            mp[l] = c[l] ? &c[l]->m->points[i] : &no_point;
-            st[l] = c[l] ? &c[l]->warm[i] : &no_state;
+            mp[l] = lm.c[l] ? &lm.c[l]->m->points[i] : &no_point;
+            st[l] = lm.c[l] ? &lm.c[l]->warm[i] : &no_state;
         }
         lane_t point[3], sep;
         gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
         SET_LANES(sep, mp[0], mp[1], mp[2], mp[3], separation);
         lane_t ra[3], rb[3];
         for (int d = 0; d < 3; d++) {
-            ra[d] = point[d] - center_a[d];
-            rb[d] = point[d] - center_b[d];
+            ra[d] = point[d] - lm.center_a[d];
+            rb[d] = point[d] - lm.center_b[d];
         }
-        CROSS(p->ra_n, ra, wb->n);
-        CROSS(p->rb_n, rb, wb->n);
-        MAT_VEC(p->ia_n, ia, p->ra_n);
-        MAT_VEC(p->ib_n, ib, p->rb_n);
-        CROSS(p->ra_t[0], ra, wb->t1);
-        CROSS(p->rb_t[0], rb, wb->t1);
-        CROSS(p->ra_t[1], ra, wb->t2);
-        CROSS(p->rb_t[1], rb, wb->t2);
-        for (int q = 0; q < 2; q++) {
-            MAT_VEC(p->ia_t[q], ia, p->ra_t[q]);
-            MAT_VEC(p->ib_t[q], ib, p->rb_t[q]);
-        }
-        /* effective masses as solver.c: 1 / (1/mA + 1/mB + (IA^-1 (rA x n)).(rA x n) + ...) */
-        lane_t kn = mab + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
-        lane_t k1 = mab + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
-        lane_t k2 = mab + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
-        lane_t ikn = one / SELECT_LANES(kn > zero, kn, one), ik1 = one / SELECT_LANES(k1 > zero, k1, one),
-               ik2 = one / SELECT_LANES(k2 > zero, k2, one);
-        p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
-        p->tangent_mass[0] = SELECT_LANES(k1 > zero, ik1, zero);
-        p->tangent_mass[1] = SELECT_LANES(k2 > zero, ik2, zero);
+        prepare_rows(wb, &lm, p, ra, rb);
         p->base_separation = sep;
         /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
         lane_t wxa[3], wxb[3];
-        CROSS(wxa, lb_wa, ra);
-        CROSS(wxb, lb_wb, rb);
+        CROSS(wxa, lm.wa, ra);
+        CROSS(wxb, lm.wb, rb);
         lane_t vrel[3];
-        for (int d = 0; d < 3; d++) vrel[d] = (lb_vb[d] + wxb[d]) - (lb_va[d] + wxa[d]);
+        for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
         lane_t vn = DOT3(vrel, wb->n);
-        lane_t ni, t1, t2;
-        SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
-        SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
-        SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
-        p->normal_impulse = warm_scale * ni;
-        p->tangent_impulse[0] = warm_scale * t1;
-        p->tangent_impulse[1] = warm_scale * t2;
-        p->total_normal_impulse = zero;
-        p->max_normal_impulse = zero;
-        for (int l = 0; l < wb->lanes; l++) {
-            constraint_point *cold = &c[l]->p[i];
-            double s = sep[l];
-            cold->relative_velocity = contact_approach_velocity(vn[l], c[l]->gravity_closing, s);
-            cold->base_separation = s;
-            cold->total_normal_impulse = 0.0;
-            cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
-            cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
-            cold->normal_mass = p->normal_mass[l];
-            cold->tangent_mass[0] = p->tangent_mass[0][l];
-            cold->tangent_mass[1] = p->tangent_mass[1][l];
-            if (-s > deepest) deepest = -s;
-        }
+        warm_point(p, st, warm);
+        deepest = store_point(wb, &lm, p, i, ra, rb, &sep, &vn, deepest);
     }
     return deepest;
 }
