@@ -11,8 +11,8 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
 
 static carom_world *ground_world(carom_world_def d)
 {
@@ -35,13 +35,6 @@ static carom_body_id box_at(carom_world *w, double x, double y, double z, double
     carom_body_id id = carom_body_create(w, &d);
     assert_false(carom_body_id_is_null(id));
     return id;
-}
-
-static carom_vec3 pos(carom_world *w, carom_body_id id)
-{
-    carom_vec3 p;
-    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
-    return p;
 }
 
 static void assert_world_finite(carom_world *w)

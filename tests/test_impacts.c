@@ -14,9 +14,8 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
-#define PI_ 3.14159265358979323846
-#define G 9.81
 
 static const char *PRESETS[3] = {"fast", "default", "accurate"};
 

@@ -14,10 +14,10 @@
 #include <float.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
 static const char *const presets[] = {"fast", "default", "accurate"};
 
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
 static int finite3(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 /* Everything a caller can read about a world, folded into one number: a

@@ -13,9 +13,9 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 #include "rotation.h"
 
-#define PI_ 3.14159265358979323846
 
 /* The box: half extents 0.5, 0.25, 0.1 m, 1 kg. */
 static const double HX = 0.5, HY = 0.25, HZ = 0.1;

@@ -14,8 +14,8 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
 
 typedef struct snap { unsigned char *data; size_t size; } snap;
 
