@@ -12,9 +12,9 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 #include "mesh_scenes.h"
 
-#define PI 3.14159265358979323846
 
 static carom_world *make_world(double gz)
 {
@@ -46,7 +46,7 @@ static void near_rel(double got, double want, double rel, const char *what)
 /* q rotating +z onto +x (a cylinder's axis along x) */
 static carom_quat z_to_x(void)
 {
-    carom_quat q = {cos(PI / 4), 0, sin(PI / 4), 0};
+    carom_quat q = {cos(PI_ / 4), 0, sin(PI_ / 4), 0};
     return q;
 }
 
@@ -59,7 +59,7 @@ static void dumbbell(carom_compound_child c[3], double r, double L, double a, do
     c[2] = carom_compound_child_default(carom_shape_cylinder(a, h));
     if (axis_y) {
         c[0].position.y = -L; c[1].position.y = L;
-        carom_quat q = {cos(PI / 4), -sin(PI / 4), 0, 0}; /* z onto +y */
+        carom_quat q = {cos(PI_ / 4), -sin(PI_ / 4), 0, 0}; /* z onto +y */
         c[2].orientation = q;
     } else {
         c[0].position.x = -L; c[1].position.x = L;
@@ -78,7 +78,7 @@ static void test_two_spheres_on_a_rod(void **state)
     carom_vec3 at = {1, 2, 3};
     carom_body_id id = add_compound(w, c, 3, CAROM_BODY_DYNAMIC, at);
     assert_false(carom_body_id_is_null(id));
-    double ms = rho * 4.0 / 3.0 * PI * r * r * r, mr = rho * PI * a * a * 2 * h;
+    double ms = rho * 4.0 / 3.0 * PI_ * r * r * r, mr = rho * PI_ * a * a * 2 * h;
     double m = 2 * ms + mr;
     double ixx = 2 * 0.4 * ms * r * r + 0.5 * mr * a * a;
     double iyy = 2 * (0.4 * ms * r * r + ms * L * L) + mr * (3 * a * a + 4 * h * h) / 12.0;
@@ -179,7 +179,7 @@ static void test_dumbbell_rolls_as_analytic(void **state)
         const double T = 2.0;
         for (int i = 0; i < 120; i++) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
         carom_body_get_center_of_mass(w, id, &p1);
-        double ms = rho * 4.0 / 3.0 * PI * r * r * r, mr = rho * PI * a * a * 2 * h, m = 2 * ms + mr;
+        double ms = rho * 4.0 / 3.0 * PI_ * r * r * r, mr = rho * PI_ * a * a * 2 * h, m = 2 * ms + mr;
         double iaxis = 2 * 0.4 * ms * r * r + 0.5 * mr * a * a;
         double acc = 9.81 * sin(th) / (1 + iaxis / (m * r * r));
         double s = (p1.x - p0.x) * cos(th) - (p1.z - p0.z) * sin(th);

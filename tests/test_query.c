@@ -13,10 +13,10 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 #include "world.h"
 #include "narrowphase.h"
 
-#define PI 3.14159265358979323846
 enum { N_CONVEX = 5 };
 static const char *const type_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane"};
 
@@ -108,33 +108,33 @@ static void sample_surface(const shape *sh, xform x, double h, samples *out)
     out->n = 0;
     if (sh->type == SHAPE_SPHERE || sh->type == SHAPE_CAPSULE) {
         double r = sh->radius, hh = sh->type == SHAPE_CAPSULE ? sh->half_height : 0;
-        int n = (int)(4 * PI * r * r / (h * h)) + 16;
+        int n = (int)(4 * PI_ * r * r / (h * h)) + 16;
         for (int i = 0; i < n; i++) { /* Fibonacci sphere, split at the equator for a capsule */
             double z = 1 - 2 * (i + 0.5) / n, rr = sqrt(1 - z * z), phi = i * 2.399963229728653;
             vec3 p = v3(r * rr * cos(phi), r * rr * sin(phi), r * z);
             p.z += z >= 0 ? hh : -hh;
             put(out, x, p);
         }
-        int nz = (int)(2 * hh / h) + 1, na = (int)(2 * PI * r / h) + 1;
+        int nz = (int)(2 * hh / h) + 1, na = (int)(2 * PI_ * r / h) + 1;
         if (hh > 0)
             for (int i = 0; i <= nz; i++)
                 for (int j = 0; j < na; j++) {
-                    double a = 2 * PI * j / na;
+                    double a = 2 * PI_ * j / na;
                     put(out, x, v3(r * cos(a), r * sin(a), -hh + 2 * hh * i / nz));
                 }
     } else if (sh->type == SHAPE_CYLINDER) {
         double r = sh->radius, hh = sh->half_height;
-        int nz = (int)(2 * hh / h) + 1, na = (int)(2 * PI * r / h) + 1, nr = (int)(r / h) + 1;
+        int nz = (int)(2 * hh / h) + 1, na = (int)(2 * PI_ * r / h) + 1, nr = (int)(r / h) + 1;
         for (int i = 0; i <= nz; i++)
             for (int j = 0; j < na; j++) {
-                double a = 2 * PI * j / na;
+                double a = 2 * PI_ * j / na;
                 put(out, x, v3(r * cos(a), r * sin(a), -hh + 2 * hh * i / nz));
             }
         for (int k = 1; k <= nr; k++) {
             double rk = r * k / nr;
-            int nk = (int)(2 * PI * rk / h) + 1;
+            int nk = (int)(2 * PI_ * rk / h) + 1;
             for (int j = 0; j < nk; j++) {
-                double a = 2 * PI * j / nk;
+                double a = 2 * PI_ * j / nk;
                 put(out, x, v3(rk * cos(a), rk * sin(a), hh));
                 put(out, x, v3(rk * cos(a), rk * sin(a), -hh));
             }
