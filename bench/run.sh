@@ -47,10 +47,14 @@ phase "broadphase pair finding"
 
 phase "speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
 # progress: one line per scene as its first row arrives
-../build/bench/sweep --runs 3 | tee out/sweep.csv | awk -F, -v t0="$start" '
-    NR > 1 && $1 != scene { scene = $1; "date +%s" | getline now; close("date +%s")
-        s = now - t0; printf "sweep: [%d:%02d] %s\n", s / 60, s % 60, scene }
-    NR > 1 { rows++ } END { printf "sweep: %d rows\n", rows }' >&2
+../build/bench/sweep --runs 3 | tee out/sweep.csv | {
+    read -r _header; scene=""; rows=0
+    while IFS=, read -r name _rest; do
+        rows=$((rows + 1))
+        if [ "$name" != "$scene" ]; then scene=$name; echo "sweep: [$(elapsed)] $name" >&2; fi
+    done
+    echo "sweep: $rows rows" >&2
+}
 if command -v gnuplot >/dev/null 2>&1; then
     lua5.4 plot.lua out/sweep.csv out | tee out/pareto.txt
 else
