@@ -11,15 +11,8 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 #include "world.h"
-
-static carom_world *make_world(void)
-{
-    carom_world_def d = carom_world_def_default();
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
-}
 
 static carom_body_id add_sphere(carom_world *w, double x, double y, double z)
 {
@@ -43,7 +36,7 @@ static void test_version_and_status(void **state)
 static void test_id_generations(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     carom_body_id a = add_sphere(w, 0, 0, 1);
     assert_false(carom_body_id_is_null(a));
     assert_true(carom_body_is_valid(w, a));
@@ -73,7 +66,7 @@ static void test_id_generations(void **state)
 static void test_store_stays_dense(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     enum { N = 4000 };
     carom_body_id *ids = calloc(N, sizeof *ids);
     double *xs = calloc(N, sizeof *xs);
@@ -142,7 +135,7 @@ static void assert_close(double a, double b, double rel)
 static void test_mass_properties(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     double I[9], m;
     inertia_of(w, carom_shape_sphere(0.3), 2.0, I, &m);
     assert_close(m, 2.0, 1e-14);
@@ -232,7 +225,7 @@ static void expect_unchanged(carom_world *w, carom_body_id *ids, int n, const sn
 static void test_rejections_leave_world_unchanged(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     carom_body_id ids[3];
     ids[0] = add_sphere(w, 0, 0, 1);
     ids[1] = add_sphere(w, 2, 0, 1);
@@ -447,7 +440,7 @@ static void test_mutation_inside_callback(void **state)
 static void test_queries(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     carom_body_def d = carom_body_def_default();
     d.type = CAROM_BODY_STATIC;
     d.position.x = 5;
