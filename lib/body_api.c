@@ -347,7 +347,9 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->gravity_scale[slot] = d.gravity_scale;
     s->plane_normal[slot] = v3_normalize(to_v3(d.plane_normal));
     s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
-    s->sleep_time[slot] = 0;
+    /* created asleep: already rested for the sleep time, so the first step
+     * does not wake it (as set_awake(false) leaves it) */
+    s->sleep_time[slot] = (s->flags[slot] & BODY_AWAKE) || d.type == CAROM_BODY_STATIC ? 0.0 : w->def.sleep_time;
     s->shapes[slot] = sh;
     s->user_data[slot] = d.user_data;
     s->previous_origin[slot] = to_v3(d.position);

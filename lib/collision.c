@@ -256,24 +256,125 @@ static void wake_for_step(carom_world *w, int slot)
     w->scratch.tight_box[slot] = shape_aabb(&s->shapes[slot], w->scratch.pose[slot]);
 }
 
+static int body_awake(const body_store *s, int slot)
+{
+    return s->type[slot] != CAROM_BODY_STATIC && (s->flags[slot] & BODY_AWAKE);
+}
+
+/* Refreshes the manifold(s) of contact i (a pair's own contact, sub 0, with
+ * at least one body awake), raises its begin/end events, lists it as
+ * touching and wakes a sleeping body it touches (counted in *woken). A pair
+ * whose bounds no longer overlap is removed when may_remove (returns 0:
+ * index i now holds another contact), else only emptied. */
+static int update_contact(carom_world *w, const step_context *ctx, int i, double reuse, int may_remove, int *woken)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    double speculative = w->def.speculative_distance;
+    double dt = ctx->dt;
+    contact *c = &cs->items[i];
+    contact_data *d = &cs->data[i];
+    int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+    int awake_a = body_awake(s, a), awake_b = body_awake(s, b);
+    int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
+    int bounds_overlap = aabb_overlap(s->fat_box[a], s->fat_box[b]);
+    if (!bounds_overlap && may_remove) {
+        if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
+        contact_remove(cs, i);
+        return 0;
+    }
+    /* a fast pair looks ahead by its closing travel this step */
+    double spec = speculative;
+    double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
+    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
+    /* bounds farther apart than the look-ahead: no point can be within it
+     * (the gap between boxes bounds the distance), so skip the narrowphase */
+    aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
+    int touching = 0; /* known without reading the manifold where possible */
+    if (composite) {
+        xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
+        int near = bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb);
+        touching = collide_composite_pair(w, i, xa, xb, spec, near);
+        c = &cs->items[i]; /* extra contacts may have moved the arrays */
+        d = &cs->data[i];
+        int was = (c->flags & CONTACT_ANY_TOUCHING) != 0;
+        c->flags = (c->flags & ~(uint32_t)CONTACT_ANY_TOUCHING) | (touching ? CONTACT_ANY_TOUCHING : 0);
+        if (touching && (!awake_a || !awake_b)) {
+            if (!awake_a && s->type[a] != CAROM_BODY_STATIC) { wake_for_step(w, a); (*woken)++; }
+            if (!awake_b && s->type[b] != CAROM_BODY_STATIC) { wake_for_step(w, b); (*woken)++; }
+        }
+        if (touching != was) {
+            /* the event speaks of the pair: any manifold with points */
+            int ei = i;
+            for (uint32_t k = 1; cs->data[ei].m.count == 0 && k < c->sub_limit; k++) {
+                int e = contact_find_sub(cs, c->id_a, c->id_b, k);
+                if (e >= 0 && cs->data[e].m.count > 0) ei = e;
+            }
+            events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
+        }
+        if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
+        return 1;
+    }
+    if (bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb)) {
+        xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
+        if (reuse_manifold(c, d, xa, xb, reuse)) {
+            touching = 1; /* kept: ids, impulses and feature cache stay as they were */
+        } else if (still_apart(c, xa, xb, spec)) {
+            touching = 0;
+        } else if (d->m.count == 0) {
+            /* most pairs near contact: nothing to carry over, nothing to copy */
+            manifold none;
+            none.count = 0;
+            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+            if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
+            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+            touching = d->m.count > 0;
+        } else {
+            manifold old_m = d->m;
+            contact_point_state old_state[MANIFOLD_MAX_POINTS];
+            memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
+            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+            if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
+            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+            touching = d->m.count > 0;
+        }
+    } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
+        d->m.count = 0;
+    }
+    int was = (c->flags & CONTACT_TOUCHING) != 0;
+    c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
+               (touching ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
+    if (touching && (!awake_a || !awake_b)) {
+        /* an awake body touching a sleeping one wakes it for this very step */
+        if (!awake_a && s->type[a] != CAROM_BODY_STATIC) { wake_for_step(w, a); (*woken)++; }
+        if (!awake_b && s->type[b] != CAROM_BODY_STATIC) { wake_for_step(w, b); (*woken)++; }
+    }
+    if (touching && !was) events_touch(w, i, CAROM_EVENT_BEGIN);
+    else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
+    if (touching) sc->touching[sc->touching_count++] = i;
+    return 1;
+}
+
 int world_collide(carom_world *w, const step_context *ctx)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
-    double speculative = w->def.speculative_distance;
-    double dt = ctx->dt;
     step_scratch *sc = &w->scratch;
     /* within the look-ahead, a feature not yet in a manifold cannot reach
      * contact while the manifold is kept */
-    double reuse = dmin(w->def.contact_reuse_distance, speculative);
+    double reuse = dmin(w->def.contact_reuse_distance, w->def.speculative_distance);
     sc->touching_count = 0;
-    /* at most every contact is touching: reserve once, so nothing below can fail */
+    sc->asleep_pair_count = 0;
+    /* at most every contact is touching (or asleep): reserve once, so nothing below can fail */
     if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
+    if (!array_reserve((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
+        return 0;
     /* ascending, and a removal re-examines index i (the last contact, not yet
      * seen, moves there), so the indices already listed stay valid */
+    int woken = 0;
     for (int i = 0; i < cs->count;) {
         contact *c = &cs->items[i];
-        contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
         if (c->sub) {
             /* an extra manifold of a mesh pair: the pair's own contact (sub 0)
@@ -282,92 +383,39 @@ int world_collide(carom_world *w, const step_context *ctx)
             else i++;
             continue;
         }
-        int awake_a = s->type[a] != CAROM_BODY_STATIC && (s->flags[a] & BODY_AWAKE);
-        int awake_b = s->type[b] != CAROM_BODY_STATIC && (s->flags[b] & BODY_AWAKE);
-        int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
         c->flags &= ~(uint32_t)CONTACT_SIM;
         if (!filter_bits_allow(s, a, b)) { /* the bits changed since the pair was made */
             if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
         }
-        if (!awake_a && !awake_b) { i++; continue; } /* a sleeping pair keeps its manifold */
-        if (!aabb_overlap(s->fat_box[a], s->fat_box[b])) {
-            if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
-            contact_remove(cs, i);
-            continue;
-        }
-        /* a fast pair looks ahead by its closing travel this step */
-        double spec = speculative;
-        double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
-        if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
-        /* bounds farther apart than the look-ahead: no point can be within it
-         * (the gap between boxes bounds the distance), so skip the narrowphase */
-        aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
-        int touching = 0; /* known without reading the manifold where possible */
-        if (composite) {
-            xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-            int near = aabb_overlap(aabb_fatten(ba, spec), bb);
-            touching = collide_composite_pair(w, i, xa, xb, spec, near);
-            c = &cs->items[i]; /* extra contacts may have moved the arrays */
-            d = &cs->data[i];
-            int was = (c->flags & CONTACT_ANY_TOUCHING) != 0;
-            c->flags = (c->flags & ~(uint32_t)CONTACT_ANY_TOUCHING) | (touching ? CONTACT_ANY_TOUCHING : 0);
-            if (touching && (!awake_a || !awake_b)) {
-                if (!awake_a) wake_for_step(w, a);
-                if (!awake_b) wake_for_step(w, b);
-            }
-            if (touching != was) {
-                /* the event speaks of the pair: any manifold with points */
-                int ei = i;
-                for (uint32_t k = 1; cs->data[ei].m.count == 0 && k < c->sub_limit; k++) {
-                    int e = contact_find_sub(cs, c->id_a, c->id_b, k);
-                    if (e >= 0 && cs->data[e].m.count > 0) ei = e;
-                }
-                events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
-            }
-            if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
+        if (!body_awake(s, a) && !body_awake(s, b)) {
+            /* a sleeping pair keeps its manifold, unless a body woken later in
+             * this pass reaches it (below) */
+            if (sc->asleep_pair_count < sc->asleep_pair_capacity) sc->asleep_pairs[sc->asleep_pair_count++] = i;
             i++;
             continue;
         }
-        if (aabb_overlap(aabb_fatten(ba, spec), bb)) {
-            xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-            if (reuse_manifold(c, d, xa, xb, reuse)) {
-                touching = 1; /* kept: ids, impulses and feature cache stay as they were */
-            } else if (still_apart(c, xa, xb, spec)) {
-                touching = 0;
-            } else if (d->m.count == 0) {
-                /* most pairs near contact: nothing to carry over, nothing to copy */
-                manifold none;
-                none.count = 0;
-                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-                if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
-                remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-                touching = d->m.count > 0;
-            } else {
-                manifold old_m = d->m;
-                contact_point_state old_state[MANIFOLD_MAX_POINTS];
-                memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
-                collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-                if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
-                remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-                touching = d->m.count > 0;
-            }
-        } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
-            d->m.count = 0;
+        if (update_contact(w, ctx, i, reuse, 1, &woken)) i++;
+    }
+    /* Waking spreads through touching pairs whatever their order in the
+     * cache: a body woken above takes part in all its pairs this step, so it
+     * never passes through a sleeping neighbour. Repeats until no pair wakes
+     * another body (each round wakes at least one, so it ends). Nothing is
+     * removed here (a mesh pair may add extra contacts at the end), so the
+     * indices listed stay valid. */
+    while (woken > 0) {
+        woken = 0;
+        for (int k = 0; k < sc->asleep_pair_count;) {
+            int i = sc->asleep_pairs[k];
+            contact *c = &cs->items[i];
+            if (!body_awake(s, s->ids[c->id_a].slot) && !body_awake(s, s->ids[c->id_b].slot)) { k++; continue; }
+            sc->asleep_pairs[k] = sc->asleep_pairs[--sc->asleep_pair_count];
+            if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, sc->touching_count + 1,
+                               sizeof *sc->touching))
+                return 0;
+            update_contact(w, ctx, i, reuse, 0, &woken);
         }
-        int was = (c->flags & CONTACT_TOUCHING) != 0;
-        c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
-                   (touching ? CONTACT_TOUCHING : 0) | (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
-        if (touching && (!awake_a || !awake_b)) {
-            /* an awake body touching a sleeping one wakes it for this very step */
-            if (!awake_a) wake_for_step(w, a);
-            if (!awake_b) wake_for_step(w, b);
-        }
-        if (touching && !was) events_touch(w, i, CAROM_EVENT_BEGIN);
-        else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
-        if (touching) sc->touching[sc->touching_count++] = i;
-        i++;
     }
     /* the extra manifolds of the mesh pairs computed above */
     if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;

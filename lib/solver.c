@@ -358,6 +358,9 @@ static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, 
         vec3 L = m3_mulv(m3_inverse(B->inv_inertia), B->w);
         bs->rotation[slot] = rotation_free_step(bs->rotation[slot], bs->inertia_local[slot], bs->inv_inertia_local[slot],
                                                 L, h, &wr);
+    } else if (B->inv_mass == 0.0) {
+        /* a kinematic body's w is constant: turn it by the exact exponential map */
+        bs->rotation[slot] = q_normalize(q_mul(q_exp(v3_scale(wr, h)), bs->rotation[slot]));
     } else {
         bs->rotation[slot] = q_integrate(bs->rotation[slot], wr, h);
     }

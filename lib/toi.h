@@ -5,6 +5,6 @@
 
 #include "step.h"
 
-void world_continuous(carom_world *w, const step_context *ctx);
+int world_continuous(carom_world *w, const step_context *ctx); /* 0 on out of memory */
 
 #endif

@@ -91,6 +91,15 @@ static inline quat q_axis_angle(vec3 axis, double angle)
     quat r = {cos(0.5 * angle), a.x * s, a.y * s, a.z * s};
     return r;
 }
+/* The rotation by rotation vector r (axis r/|r|, angle |r|): the exact
+ * exponential map (sin(x)/x by its series near 0, so tiny angles lose nothing). */
+static inline quat q_exp(vec3 r)
+{
+    double angle = v3_len(r), half = 0.5 * angle;
+    double k = half < 1e-4 ? 0.5 - angle * angle / 48.0 : sin(half) / angle; /* sin(angle/2)/angle */
+    quat q = {cos(half), r.x * k, r.y * k, r.z * k};
+    return q;
+}
 /* q advanced by angular velocity w (world frame) over h, renormalised. */
 static inline quat q_integrate(quat q, vec3 w, double h)
 {

@@ -195,7 +195,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
     free(s->tight_box); free(s->pose); free(s->touching);
     free(w->sensor_overlaps);
-    free(s->new_pairs);
+    free(s->new_pairs); free(s->asleep_pairs); free(s->toi);
     free(w);
 }
 
@@ -312,7 +312,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
         }
     }
     double t4 = now_ms();
-    if (ok && w->def.enable_continuous) world_continuous(w, &ctx);
+    if (ok && w->def.enable_continuous) ok = world_continuous(w, &ctx);
     double t5 = now_ms();
     if (ok) world_update_sleep(w, &ctx);
     if (ok) ok = world_update_sensors(w);

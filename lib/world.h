@@ -39,6 +39,10 @@ typedef struct step_scratch {
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;
     impact_memory impact;       /* impact.c's per-body states and pairs */
+    int *asleep_pairs;          /* contacts both of whose bodies slept when the collision pass met them */
+    int asleep_pair_count, asleep_pair_capacity;
+    void *toi;                  /* toi.c's per-slot sweeps and stop fractions */
+    size_t toi_capacity;
     int *deferred_destroy;      /* id indices destroyed from callbacks */
     int deferred_count, deferred_capacity;
     uint64_t *new_pairs;        /* pairs the broadphase found this step, sorted before they are added */

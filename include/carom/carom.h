@@ -364,7 +364,7 @@ typedef struct carom_body_def {
     int lock_to_plane;             /* 0: 1 keeps the body in the plane through its start
                                       position with normal plane_normal (2D) */
     carom_vec3 plane_normal;       /* (0, 1, 0): the x-z plane */
-    int bullet;                    /* 0: 1 = continuous collision against dynamic bodies too */
+    int bullet;                    /* 0: 1 = swept every step, however slowly it moves (fast bodies always are) */
     int enable_sleep;              /* 1 */
     int awake;                     /* 1 */
     void *user_data;               /* NULL */
