@@ -124,5 +124,16 @@ void body_update_inertia(body_store *s, int slot)
         return;
     }
     mat3 r = m3_from_quat(s->rotation[slot]);
+    if ((s->flags[slot] & BODY_LOCK_PLANE) && s->inv_mass[slot] > 0.0) {
+        /* the body turns about the plane normal n only: the reduced system's
+         * response to a torque t is n (n.t) / (n.I n) (not the free I^-1 t
+         * projected onto n) */
+        vec3 n = s->plane_normal[slot];
+        vec3 nl = m3_tmulv(r, n); /* n in body axes */
+        double inn = v3_dot(nl, m3_mulv(s->inertia_local[slot], nl));
+        double k = inn > 0.0 ? 1.0 / inn : 0.0;
+        s->inv_inertia_world[slot] = m3_cols(v3_scale(n, k * n.x), v3_scale(n, k * n.y), v3_scale(n, k * n.z));
+        return;
+    }
     s->inv_inertia_world[slot] = m3_rotate_tensor(r, s->inv_inertia_local[slot]);
 }

@@ -173,6 +173,20 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     return 1;
 }
 
+/* 1 when a point of the manifold already touches (separation <= 0) and the
+ * bodies approach there faster than max_push before solving. */
+static int touching_impact(const contact_constraint *c, const impulse_body *A, const impulse_body *B, vec3 ca, vec3 cb,
+                           double max_push)
+{
+    for (int j = 0; j < c->count; j++) {
+        const manifold_point *mp = &c->m->points[j];
+        if (mp->separation > 0.0) continue;
+        vec3 ra = v3_sub(mp->point, ca), rb = v3_sub(mp->point, cb);
+        if (impulse_relative_normal_velocity(B, A, rb, ra, c->n) < -max_push) return 1;
+    }
+    return 0;
+}
+
 /* One header per manifold the collision stage listed as touching: bodies,
  * basis, material, softness; the points stay for prepare_points. */
 static void fill_constraint(carom_world *w, const step_context *ctx, contact_constraint *c, int i)
@@ -202,6 +216,14 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->warm = cd->state;
     c->center_a = bs->center[sa];
     c->center_b = bs->center[sb];
+    if (touching_impact(c, &bodies[c->a], &bodies[c->b], c->center_a, c->center_b, ctx->push_max)) {
+        /* a touching pair driven together faster than the soft contact may
+         * push out is stopped rigidly, as a speculative contact would be: a
+         * soft one lets a few per cent of the approach through each sub-step
+         * (a resting 0.1 m sphere struck at 100 m/s sank 9.9 mm at fast) */
+        c->soft.mass_scale = 1.0;
+        c->soft.impulse_scale = 0.0;
+    }
     /* every force acting over the step, not only gravity: b's acceleration relative to a along n */
     vec3 grav = ctx->gravity;
     vec3 acc_a = bodies[c->a].inv_mass > 0.0
@@ -502,7 +524,10 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
             bs->force[slot] = v3_zero();
             bs->flags[slot] &= ~(uint32_t)BODY_HAS_FORCE;
         }
-        if (!(bs->flags[slot] & BODY_LOCK_ROTATION) && B->inv_mass > 0.0 && (av.x != 0.0 || av.y != 0.0 || av.z != 0.0)) {
+        /* (a plane-locked body turns about the plane normal only, and n.I n is
+         * the same in every orientation it reaches: its w needs no carrying) */
+        if (!(bs->flags[slot] & (BODY_LOCK_ROTATION | BODY_LOCK_PLANE)) && B->inv_mass > 0.0 &&
+            (av.x != 0.0 || av.y != 0.0 || av.z != 0.0)) {
             /* the solver worked with the step's starting inertia; carry its angular
              * momentum L = I_start w to the new orientation (w = I_end^-1 L), so a
              * freely tumbling body conserves L rather than w */

@@ -149,7 +149,7 @@ static double pair_toi(const toi_context *ctx, int a, int b, double limit)
     double d0 = separation_at(ctx, a, b, 0.0, range, &n);
     /* already touching: may sink a little deeper, no more */
     double tolerance = 0.25 * ctx->target;
-    double stop = d0 > ctx->target + tolerance ? ctx->target : d0 - ctx->slop;
+    double stop = d0 > ctx->target + tolerance ? ctx->target : d0 - ctx->slop + tolerance;
     double t = 0.0, d = d0;
     for (int it = 0; it < TOI_MAX_ITERATIONS; it++) {
         if (d <= stop + tolerance) return t;

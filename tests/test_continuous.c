@@ -249,6 +249,48 @@ static void test_kinematic_rotation_is_exact(void **state)
             }
 }
 
+/* Issue 17, finding 6: a body resting on a static plane or box and struck
+ * straight down (100 to 4000 m/s), or sent sliding along it at the speed
+ * clamp, must not end inside it: a pair already touching gets no sweep of
+ * its own, so the contact must stop it. Spheres of 1e-6 to 0.1 m and a small
+ * capsule, every preset; depth after each step within linear_slop. */
+static void test_issue17_finding6_struck_resting_body_stays_out(void **state)
+{
+    (void)state;
+    const double radii[] = {1e-6, 1e-3, 0.1};
+    const double speeds[] = {100, 1000, 4000};
+    for (int p = 0; p < 3; p++)
+        for (int floor = 0; floor < 2; floor++)
+            for (int r = 0; r < 3; r++)
+                for (int kind = 0; kind < 2; kind++)
+                    for (int k = 0; k < 4; k++) {
+                        carom_world *w = world_preset(presets[p], 1);
+                        carom_world_def d = carom_world_def_default();
+                        assert_int_equal(carom_world_get_def(w, &d), CAROM_OK);
+                        if (floor) add_static(w, carom_shape_box(1e3, 1e3, 0.5), vec(0, 0, -0.5));
+                        else add_static(w, carom_shape_plane(0, 0, 1, 0), vec(0, 0, 0));
+                        double rad = radii[r];
+                        carom_shape_def shape = kind ? carom_shape_capsule(rad, 2 * rad) : carom_shape_sphere(rad);
+                        carom_quat lying = about_x(PI_ / 2);
+                        carom_body_id id = add_body(w, shape, vec(0, 0, rad), kind ? lying : about_x(0), vec(0, 0, 0),
+                                                    vec(0, 0, 0));
+                        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+                        /* k < 3: struck down; k = 3: sliding at the clamp */
+                        carom_vec3 v = k < 3 ? vec(0, 0, -speeds[k]) : vec(d.max_linear_speed, 0, 0);
+                        assert_int_equal(carom_body_set_linear_velocity(w, id, v), CAROM_OK);
+                        double deepest = run_deepest(w, 3, 1.0 / 60);
+                        if (deepest > d.linear_slop) {
+                            print_error("%s %s %s r %g %s: %.5f m deep\n", presets[p], floor ? "box" : "plane",
+                                        kind ? "capsule" : "sphere", rad,
+                                        k < 3 ? "struck down" : "sliding", deepest);
+                            fail();
+                        }
+                        /* and it is not below the surface by more than that either */
+                        assert_true(pos(w, id).z - rad > -d.linear_slop);
+                        carom_world_destroy(w);
+                    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -256,6 +298,7 @@ int main(void)
         cmocka_unit_test(test_spinning_rod_stays_above_the_floor),
         cmocka_unit_test(test_fast_dynamic_bodies_meet),
         cmocka_unit_test(test_kinematic_rotation_is_exact),
+        cmocka_unit_test(test_issue17_finding6_struck_resting_body_stays_out),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
