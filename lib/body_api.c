@@ -146,9 +146,9 @@ static int check_body_def(carom_world *w, const carom_body_def *d)
     if (!speed_ok(d->linear_velocity, w->def.max_linear_speed))
         FAIL("body_create: linear speed %g m/s is above the world's max_linear_speed %g m/s", len_c(d->linear_velocity),
              w->def.max_linear_speed);
-    if (!speed_ok(d->angular_velocity, w->def.max_angular_speed))
+    if (!speed_ok(d->angular_velocity, world_spin_limit(&w->def)))
         FAIL("body_create: angular speed %g rad/s is above the world's max_angular_speed %g rad/s",
-             len_c(d->angular_velocity), w->def.max_angular_speed);
+             len_c(d->angular_velocity), world_spin_limit(&w->def));
     if (!(isfinite(d->mass) && d->mass >= 0)) FAIL("body_create: mass must be finite and >= 0 (got %g)", d->mass);
     if (d->mass > 0 && !(d->mass >= RANGE_MASS_MIN && d->mass <= RANGE_MASS_MAX))
         FAIL("body_create: mass %g kg is outside [1e-9, 1e15] kg", d->mass);
@@ -594,10 +594,10 @@ CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_bod
     if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_VELOCITY, id, av, NULL, "body_set_angular_velocity");
     REQUIRE_UNLOCKED(w, "body_set_angular_velocity");
     if (!finite_c(av)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_angular_velocity: must be finite");
-    if (!speed_ok(av, w->def.max_angular_speed))
+    if (!speed_ok(av, world_spin_limit(&w->def)))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
                           "body_set_angular_velocity: speed %g rad/s is above the world's max_angular_speed %g rad/s",
-                          len_c(av), w->def.max_angular_speed);
+                          len_c(av), world_spin_limit(&w->def));
     body_store *s = &w->bodies;
     if (s->type[slot] == CAROM_BODY_STATIC)
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_angular_velocity: a static body cannot move");
@@ -756,10 +756,10 @@ CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
                           "body_apply_impulse: resulting speed %g m/s is above the world's max_linear_speed %g m/s",
                           v3_len(nv), w->def.max_linear_speed);
-    if (v3_len(nw) > w->def.max_angular_speed)
+    if (v3_len(nw) > world_spin_limit(&w->def))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
                           "body_apply_impulse: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s",
-                          v3_len(nw), w->def.max_angular_speed);
+                          v3_len(nw), world_spin_limit(&w->def));
     s->velocity[slot] = nv;
     s->angular_velocity[slot] = nw;
     world_wake_body(w, slot);

@@ -44,10 +44,10 @@ CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *w, carom_bo
     if (s->type[slot] != CAROM_BODY_DYNAMIC || (s->flags[slot] & BODY_LOCK_ROTATION)) return CAROM_OK;
     vec3 nw = v3_add(s->angular_velocity[slot], m3_mulv(s->inv_inertia_world[slot], to_v3(impulse)));
     if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
-    if (!(v3_len(nw) <= w->def.max_angular_speed))
+    if (!(v3_len(nw) <= world_spin_limit(&w->def)))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
                           "%s: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s", fn, v3_len(nw),
-                          w->def.max_angular_speed);
+                          world_spin_limit(&w->def));
     s->angular_velocity[slot] = nw;
     world_wake_body(w, slot);
     return CAROM_OK;

@@ -132,6 +132,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
 {
     body_store *bs = &w->bodies;
     step_scratch *s = &w->scratch;
+    double wmax = world_spin_clamp(&w->def, ctx->h);
     for (int i = 0; i < bs->count; i++) bs->solver_index[i] = 0;
     if (!array_reserve((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
     /* the per-body scratch arrays share one capacity */
@@ -159,7 +160,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         /* clamp before integrating: a finite but huge velocity set by the user
          * would otherwise overflow the pose to inf/NaN within the step */
         bodies[k].v = clamp_length(bs->velocity[i], w->def.max_linear_speed, &work->clamped);
-        bodies[k].w = clamp_length(bs->angular_velocity[i], w->def.max_angular_speed, &work->clamped);
+        bodies[k].w = clamp_length(bs->angular_velocity[i], wmax, &work->clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
         s->delta_position[k] = v3_zero();
@@ -504,7 +505,7 @@ static void reset_non_finite(carom_world *w, const step_context *ctx, int b, vec
 static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *work)
 {
     body_store *bs = &w->bodies;
-    double vmax = w->def.max_linear_speed, wmax = w->def.max_angular_speed;
+    double vmax = w->def.max_linear_speed, wmax = world_spin_clamp(&w->def, ctx->h);
     for (int b = 1; b < ctx->body_count; b++) {
         int slot = ctx->body_slot[b];
         const impulse_body *B = &ctx->bodies[b];

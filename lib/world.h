@@ -76,6 +76,23 @@ struct carom_world {
     carom_status last_status;   /* the status world_fail last recorded */
 };
 
+/* The angular speed clamp. max_angular_speed > 0 is the user's cap, honoured
+ * as given (also by the setters). 0 (the default) is automatic: the step
+ * clamps at the larger of 1000 rad/s and a quarter turn per sub-step, so it
+ * never alters a body the rotation can still resolve (w h < pi/2, the
+ * quarter-turn rule), and setters accept up to the range's ceiling. */
+#define WORLD_SPIN_AUTO_FLOOR 1000.0 /* rad/s: the automatic clamp at long steps */
+#define WORLD_SPIN_AUTO_LIMIT 1e9    /* rad/s: what setters accept when automatic (RANGE_SPEED_MAX) */
+static inline double world_spin_clamp(const carom_world_def *d, double h)
+{
+    if (d->max_angular_speed > 0.0) return d->max_angular_speed;
+    double quarter_turn = 1.5707963267948966 / h;
+    return quarter_turn > WORLD_SPIN_AUTO_FLOOR ? quarter_turn : WORLD_SPIN_AUTO_FLOOR;
+}
+static inline double world_spin_limit(const carom_world_def *d)
+{
+    return d->max_angular_speed > 0.0 ? d->max_angular_speed : WORLD_SPIN_AUTO_LIMIT;
+}
 
 #include "world_state.h"
 

@@ -227,7 +227,7 @@ static const edge edges[] = {
     {"damping", 1e6, +1, "[0, 1e6] 1/s", NULL, b_damping, NULL, 1.0 / 60},
     {"gravity scale", 1e4, +1, "[-1e4, 1e4]", NULL, b_gravity_scale, NULL, 1.0 / 60},
     {"speed at creation", 4000, +1, "max_linear_speed 4000 m/s", NULL, b_speed, NULL, 1.0 / 60},
-    {"spin at creation", 1000, +1, "max_angular_speed 1000 rad/s", NULL, b_spin, NULL, 1.0 / 60},
+    {"spin at creation", 1e9, +1, "max_angular_speed 1e+09 rad/s", NULL, b_spin, NULL, 1.0 / 60},
     {"set_linear_velocity", 4000, +1, "max_linear_speed 4000 m/s", NULL, NULL, s_speed, 1.0 / 60},
     {"force over mass", 1e9, +1, "above 1e9 m/s^2", NULL, NULL, s_force, 1.0 / 60},
     {"gravity", 1e4, +1, "at most 1e4 m/s^2", w_gravity, NULL, NULL, 1.0 / 60},

@@ -263,6 +263,82 @@ static void test_fast_rod(void **state)
     }
 }
 
+/* The quarter-turn rule: at the default (automatic) max_angular_speed the
+ * clamp never alters a body turning less than a quarter turn per sub-step,
+ * at every preset and dt 1/15..1/1000; above both that and 1000 rad/s it
+ * clamps to exactly the larger of the two; an explicit cap is honoured even
+ * where it clamps a slow body. A sphere (|w| constant when free) and the
+ * issue's box about its major axis (|w| constant to the integrator's
+ * round-off). */
+static double spin_after(carom_world *w, carom_body_id id, int steps, double dt, long *clamped)
+{
+    *clamped = 0;
+    for (int i = 0; i < steps; i++) { /* stats.clamped counts the last step's */
+        assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+        carom_world_stats st = carom_world_stats_init();
+        assert_int_equal(carom_world_get_stats(w, &st), CAROM_OK);
+        *clamped += st.clamped;
+    }
+    carom_vec3 wv;
+    assert_int_equal(carom_body_get_angular_velocity(w, id, &wv), CAROM_OK);
+    return sqrt(wv.x * wv.x + wv.y * wv.y + wv.z * wv.z);
+}
+
+static void test_quarter_turn_rule(void **state)
+{
+    (void)state;
+    const double dts[5] = {1.0 / 15, 1.0 / 30, 1.0 / 60, 1.0 / 240, 1.0 / 1000};
+    for (int pr = 0; pr < 3; pr++)
+        for (int k = 0; k < 5; k++)
+            for (int shape = 0; shape < 2; shape++) {
+                carom_world_def d = carom_world_def_default();
+                assert_int_equal(carom_world_def_apply_preset(&d, PRESETS[pr]), CAROM_OK);
+                d.gravity = cv(0, 0, 0);
+                double h = dts[k] / d.substeps, quarter = 0.5 * PI_ / h;
+                double clamp = quarter > 1000.0 ? quarter : 1000.0;
+                double rates[2] = {0.999 * quarter, 1.5 * clamp};
+                for (int r = 0; r < 2; r++) {
+                    carom_world *w = carom_world_create(&d);
+                    assert_non_null(w);
+                    carom_body_def b = carom_body_def_default();
+                    b.shape = shape ? carom_shape_box(HX, HY, HZ) : carom_shape_sphere(0.3);
+                    b.mass = 1.0;
+                    b.angular_velocity = cv(0, 0, rates[r]);
+                    carom_body_id id = carom_body_create(w, &b);
+                    assert_false(carom_body_id_is_null(id));
+                    long clamped;
+                    double got = spin_after(w, id, 3, dts[k], &clamped);
+                    print_message("%s dt 1/%.0f %s at %.0f rad/s (quarter turn %.0f): %.6f rad/s, clamped %ld\n",
+                                  PRESETS[pr], 1 / dts[k], shape ? "box" : "sphere", rates[r], quarter, got, clamped);
+                    if (r == 0) {
+                        assert_int_equal(clamped, 0);
+                        assert_true(fabs(got / rates[r] - 1) < 1e-9);
+                    } else {
+                        assert_true(clamped >= 1);
+                        assert_true(fabs(got / clamp - 1) < 1e-9);
+                    }
+                    carom_world_destroy(w);
+                }
+                /* an explicit cap, lowered below the body's spin, is honoured */
+                d.max_angular_speed = 0.5 * quarter;
+                carom_world *w = carom_world_create(&d);
+                carom_body_def b = carom_body_def_default();
+                b.shape = carom_shape_sphere(0.3);
+                b.angular_velocity = cv(0, 0, 0.4 * quarter);
+                carom_body_id id = carom_body_create(w, &b);
+                assert_false(carom_body_id_is_null(id));
+                assert_int_equal(carom_body_set_angular_velocity(w, id, cv(0, 0, 0.6 * quarter)),
+                                 CAROM_ERROR_INVALID_ARGUMENT);
+                d.max_angular_speed = 0.1 * quarter;
+                assert_int_equal(carom_world_set_def(w, &d), CAROM_OK);
+                long clamped;
+                double got = spin_after(w, id, 2, dts[k], &clamped);
+                assert_true(clamped >= 1);
+                assert_true(fabs(got / (0.1 * quarter) - 1) < 1e-9);
+                carom_world_destroy(w);
+            }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -272,6 +348,7 @@ int main(void)
         cmocka_unit_test(test_box_intermediate_axis_flips),
         cmocka_unit_test(test_box_sizes_and_rates),
         cmocka_unit_test(test_fast_rod),
+        cmocka_unit_test(test_quarter_turn_rule),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -130,7 +130,9 @@ typedef struct carom_world_def {
     double sleep_linear_velocity;       /* 0.05 m/s */
     double sleep_angular_velocity;      /* 0.05 rad/s */
     double max_linear_speed;            /* 4000 m/s: clamp; clamping raises stats.clamped */
-    double max_angular_speed;           /* 1000 rad/s */
+    double max_angular_speed;           /* 0: automatic, the larger of 1000 rad/s and a quarter
+                                           turn per sub-step (setters accept up to 1e9 rad/s);
+                                           > 0: a cap honoured as given, also by the setters */
     int body_capacity;                  /* 0: initial storage hint */
     carom_event_fn *event_callback;     /* NULL: events are only buffered */
     void *event_context;
@@ -173,7 +175,7 @@ static inline carom_world_def carom_world_def_default(void)
     d.sleep_linear_velocity = 0.05;
     d.sleep_angular_velocity = 0.05;
     d.max_linear_speed = 4000.0;
-    d.max_angular_speed = 1000.0;
+    d.max_angular_speed = 0.0;
     d.body_capacity = 0;
     d.event_callback = 0;
     d.event_context = 0;
