@@ -25,7 +25,8 @@
 #include "mesh.h"
 
 #define TRI_FACE_TOLERANCE 1e-3   /* prefer the triangle's face unless another axis separates more (m) */
-#define GROUP_COS 0.999           /* contacts within ~2.5 degrees of a group's normal join it */
+#define GROUP_COS 0.999           /* polytope contacts within ~2.5 degrees of a group's normal join it */
+#define CORE_GROUP_COS (1.0 - 1e-9) /* sphere and capsule contacts: only the same normal */
 #define GROUP_CAPACITY 64
 
 /* ---- one triangle ------------------------------------------------------------- */
@@ -156,6 +157,27 @@ static void add_rim_point(const vec3 v[3], vec3 n, const shape *cyl, xform x, do
     m->normal = n;
 }
 
+/* Whether a contact on the shape's face (outward normal fn; its points on
+ * the triangle, each moved half its separation along -fn) comes from an
+ * active feature of the triangle: the one its deepest point lies on, an
+ * edge or a vertex (a point inside the triangle: its face). Judged by the
+ * clipped points, not by the triangle's vertex nearest the face's plane: a
+ * face turned a hair off parallel to an internal edge would otherwise see
+ * that edge's far vertex, active on a mesh's border a metre away. */
+static int face_contact_active(const vec3 v[3], vec3 n, unsigned active, vec3 fn, const manifold *alt)
+{
+    int deepest = 0;
+    for (int i = 1; i < alt->count; i++)
+        if (alt->points[i].separation < alt->points[deepest].separation) deepest = i;
+    vec3 q = v3_madd(alt->points[deepest].point, 0.5 * alt->points[deepest].separation, fn);
+    double scale = v3_len(v3_sub(v[1], v[0])) + v3_len(v3_sub(v[2], v[0]));
+    int on[3], count = 0;
+    for (int k = 0; k < 3; k++) count += on[k] = v3_dot(edge_side(v, n, k), v3_sub(q, v[k])) >= -1e-9 * scale;
+    if (count == 0) return 1;
+    if (count >= 2) return vertex_active(active, on[0] && on[1] ? 1 : on[1] && on[2] ? 2 : 0);
+    return (int)(active >> (on[0] ? 0 : on[1] ? 1 : 2) & 1u);
+}
+
 /* A polytope p (built from shape s at xs; edge faces filled) against the triangle. */
 static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const poly *p, const shape *s, xform xs,
                               double spec, manifold *m)
@@ -223,16 +245,8 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
         push_point(&alt, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
     } else if (best_f >= 0 && sep_f > sep_t + TRI_FACE_TOLERANCE && !(ek >= 0 && sep_e > sep_f + TRI_FACE_TOLERANCE) &&
                !(cyl && best_f < CYL_SIDES)) { /* a prism facet only approximates a round side */
-        /* the triangle's feature nearest that face: a vertex, an edge or all of it */
-        vec3 nf = v3_neg(p->fn[best_f]);
-        double top = dmax(v3_dot(nf, v[0]), dmax(v3_dot(nf, v[1]), v3_dot(nf, v[2])));
-        double scale = v3_len(v3_sub(v[1], v[0])) + v3_len(v3_sub(v[2], v[0]));
-        int on[3], count = 0;
-        for (int k = 0; k < 3; k++) count += on[k] = top - v3_dot(nf, v[k]) <= 1e-9 * scale;
-        int feature_active = 1;
-        if (count == 1) feature_active = vertex_active(active, on[0] ? 0 : on[1] ? 1 : 2);
-        else if (count == 2) feature_active = (int)(active >> (on[0] && on[1] ? 0 : on[1] && on[2] ? 1 : 2) & 1u);
-        if (feature_active) poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, &alt);
+        poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, &alt);
+        if (alt.count > 0 && !face_contact_active(v, n, active, p->fn[best_f], &alt)) alt.count = 0;
     }
     if (alt.count > 0) *m = alt;
     /* apart: points clipped to a reference face can miss the nearest corner
@@ -365,6 +379,22 @@ int manifold_outline(manifold_point *pts, int n, vec3 normal)
     return h;
 }
 
+/* A sphere or capsule contact point (p, separation along n) moved to the
+ * group's normal g: the point at the bottom of the core along g, the
+ * separation of the same triangle feature along g (no more than the true
+ * distance). A sphere's point left where an edge's normal put it, off the
+ * line through its centre along g, moves up and down as the sphere rolls:
+ * the solver then lifts it (the bump of a sphere rolling onto the next of
+ * several separate mesh patches, 51 mm off its path on a plane). */
+static void core_along(manifold_point *mp, vec3 n, vec3 g, double r)
+{
+    vec3 core = v3_madd(mp->point, r + 0.5 * mp->separation, n);
+    vec3 feature = v3_madd(mp->point, -0.5 * mp->separation, n);
+    double sep = v3_dot(g, v3_sub(core, feature)) - r;
+    mp->point = v3_madd(core, -(r + 0.5 * sep), g);
+    mp->separation = sep;
+}
+
 static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t index)
 {
     composite_query *q = ctx;
@@ -378,7 +408,7 @@ static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t 
         double c = v3_dot(q->groups[i].normal, m.normal);
         if (c > best) { best = c; g = i; }
     }
-    if (best < GROUP_COS && q->group_count < q->max_groups) {
+    if (best < (q->cv.is_core ? CORE_GROUP_COS : GROUP_COS) && q->group_count < q->max_groups) {
         g = q->group_count++;
         q->groups[g].normal = m.normal;
         q->groups[g].count = 0;
@@ -391,13 +421,16 @@ static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t 
             if (gr->count > GROUP_CAPACITY / 2) gr->count = manifold_reduce(gr->points, gr->count, gr->normal);
         }
         manifold_point mp = m.points[i];
+        /* more normals than groups: a sphere's point goes to the group's normal */
+        int moved = q->cv.is_core && v3_dot(gr->normal, m.normal) < CORE_GROUP_COS;
+        if (moved) core_along(&mp, m.normal, gr->normal, q->cv.s->radius);
         /* a vertex of the shape itself on the triangle's face keeps its id
          * from triangle to triangle (warm starting follows it); other points
          * are told apart by the triangle */
         if (mp.id & 0xfff0ff80u) mp.id = (mp.id & 0x3fffffffu) ^ (index * 0x9E3779B1u);
         if (mp.separation < gr->deepest) {
             gr->deepest = mp.separation;
-            gr->normal = m.normal; /* the deepest triangle's normal speaks for the group */
+            if (!moved) gr->normal = m.normal; /* the deepest triangle's normal speaks for the group */
         }
         gr->points[gr->count++] = mp;
     }

