@@ -42,6 +42,11 @@ typedef struct contact_constraint {
     const contact_point_state *warm; /* last step's impulses, matched by feature */
     vec3 center_a, center_b;     /* centres of mass */
     double gravity_closing;      /* normal acceleration of b relative to a from gravity and forces */
+    /* plane-locked bodies (lock_to_plane): the plane normals, zero for a free
+     * body; such a manifold takes the scalar passes, which keep the locked
+     * bodies' velocities in their planes */
+    vec3 lock_a, lock_b;
+    int locked;
 } contact_constraint;
 
 /* ---- the shared formulas ------------------------------------------------ */
@@ -66,6 +71,18 @@ static inline double contact_approach_velocity(double vn, double gravity_closing
         return -sqrt(vn * vn - 2.0 * gravity_closing * separation);
     return vn;
 }
+
+/* A body's share 1/m of the inverse effective mass along unit direction d,
+ * when the body moves only in the plane with unit normal l (l = 0: free):
+ * its linear response to an impulse along d is (1/m)(d - (d.l) l). */
+static inline double locked_inv_mass(double inv_mass, vec3 d, vec3 l)
+{
+    double dl = v3_dot(d, l);
+    return inv_mass * (1.0 - dl * dl);
+}
+
+/* A plane-locked body's velocity kept in its plane (l = 0: unchanged). */
+static inline vec3 keep_in_plane(vec3 v, vec3 l) { return v3_madd(v, -v3_dot(v, l), l); }
 
 /* Coulomb's cone: the factor that scales a friction impulse of squared
  * length mag2 back to |t| <= limit (1 inside the cone). */

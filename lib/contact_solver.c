@@ -31,9 +31,14 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         }
         /* the seed's denominator 1/m1 + 1/m2 + n.((I1^-1 (r1 x n)) x r1) + ..., from the
          * rows above: n.((I^-1 (r x n)) x r) = (I^-1 (r x n)).(r x n) */
-        double kn = A->inv_mass + B->inv_mass + v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
-        double k1 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
-        double k2 = A->inv_mass + B->inv_mass + v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
+        /* (a plane-locked body's 1/m counts only the row's part in its plane;
+         * its inverse inertia is already the reduced n n^T / (n.I n)) */
+        double kn = locked_inv_mass(A->inv_mass, c->n, c->lock_a) + locked_inv_mass(B->inv_mass, c->n, c->lock_b) +
+                    v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
+        double k1 = locked_inv_mass(A->inv_mass, c->t1, c->lock_a) + locked_inv_mass(B->inv_mass, c->t1, c->lock_b) +
+                    v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
+        double k2 = locked_inv_mass(A->inv_mass, c->t2, c->lock_a) + locked_inv_mass(B->inv_mass, c->t2, c->lock_b) +
+                    v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
         p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
         p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
         p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
@@ -70,6 +75,7 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
         p->total_normal_impulse += p->normal_impulse;
         /* seed convention: body 1 = B receives +P (n points from A to B) */
         impulse_apply(B, A, p->rb, p->ra, P);
+        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
     }
 }
 
@@ -113,6 +119,7 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
         wA = v3_madd(wA, -lambda, p->ia_n);
         vB = v3_madd(vB, mB * lambda, n);
         wB = v3_madd(wB, lambda, p->ib_n);
+        if (c->locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
     }
     if (ctx->friction && c->friction > 0) {
         vec3 dv = v3_sub(vB, vA);
@@ -132,6 +139,7 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
             vB = v3_madd(vB, mB, P);
             wA = v3_sub(wA, v3_add(v3_scale(p->ia_t[0], d1), v3_scale(p->ia_t[1], d2)));
             wB = v3_add(wB, v3_add(v3_scale(p->ib_t[0], d1), v3_scale(p->ib_t[1], d2)));
+            if (c->locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
             dv = v3_sub(vB, vA);
         }
     }
@@ -158,7 +166,8 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         vec3 ra_n = v3_cross(p->ra, n), rb_n = v3_cross(p->rb, n);
         vec3 ia_n = m3_mulv(A->inv_inertia, ra_n), ib_n = m3_mulv(B->inv_inertia, rb_n);
         double s = p->base_separation + v3_dot(n, dpab) + v3_dot(ctx->dq[c->b], rb_n) - v3_dot(ctx->dq[c->a], ra_n);
-        double k = fa * (A->inv_mass + v3_dot(ra_n, ia_n)) + fb * (B->inv_mass + v3_dot(rb_n, ib_n));
+        double k = fa * (locked_inv_mass(A->inv_mass, n, c->lock_a) + v3_dot(ra_n, ia_n)) +
+                   fb * (locked_inv_mass(B->inv_mass, n, c->lock_b) + v3_dot(rb_n, ib_n));
         p->shock_normal = 0.0;
         if (k <= 0) continue;
         /* rigid against an immovable lower body, with the soft push-out rate */
@@ -177,6 +186,7 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         A->w = v3_madd(A->w, -fa * lambda, ia_n);
         B->v = v3_madd(B->v, fb * B->inv_mass * lambda, n);
         B->w = v3_madd(B->w, fb * lambda, ib_n);
+        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
     }
     if (!ctx->friction || c->friction <= 0) return;
     for (int i = 0; i < c->count; i++) {
@@ -186,8 +196,8 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         double nw[2];
         for (int j = 0; j < 2; j++) {
             vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
-            double k = fa * (A->inv_mass + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
-                       fb * (B->inv_mass + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
+            double k = fa * (locked_inv_mass(A->inv_mass, t[j], c->lock_a) + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
+                       fb * (locked_inv_mass(B->inv_mass, t[j], c->lock_b) + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
             nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
         }
         /* Coulomb on the total: what the regular pass used plus this pass */
@@ -199,5 +209,6 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
         B->v = v3_madd(B->v, fb * B->inv_mass, P);
         B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(p->rb, P)), fb));
+        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
     }
 }

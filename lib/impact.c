@@ -136,7 +136,10 @@ static void pair_geometry(carom_world *w, const contact_constraint *cc, const im
     for (int j = 0; j < m.count; j++) {
         ip->ra[j] = v3_sub(m.points[j].point, ca);
         ip->rb[j] = v3_sub(m.points[j].point, cb);
-        double k = impulse_inverse_effective_mass(B, A, ip->rb[j], ip->ra[j], m.normal);
+        /* a plane-locked body moves along the normal only by its part in the plane */
+        double k = impulse_inverse_effective_mass(B, A, ip->rb[j], ip->ra[j], m.normal) -
+                   (A->inv_mass - locked_inv_mass(A->inv_mass, m.normal, c->lock_a)) -
+                   (B->inv_mass - locked_inv_mass(B->inv_mass, m.normal, c->lock_b));
         ip->normal_mass[j] = k > 0.0 ? 1.0 / k : 0.0;
     }
 }
@@ -148,12 +151,12 @@ static int pair_collide(carom_world *w, const contact_constraint *cc, impact_bod
     impulse_body *A = &bodies[ip->a], *B = &bodies[ip->b];
     if (ip->count == 0) {
         /* not met yet: does it meet within the step at the velocities now? */
-        const contact_constraint *c = &cc[ip->con];
-        double t = pair_contact_time(bodies, st, c, dt);
+        double t = pair_contact_time(bodies, st, &cc[ip->con], dt);
         if (t < 0.0) return 0;
         pair_geometry(w, cc, st, ip, t, dt);
         if (ip->count == 0) return 0;
     }
+    const contact_constraint *c = &cc[ip->con];
     double tau = dmax(ip->tau, dmax(st[ip->a].tau, st[ip->b].tau));
     /* normal velocity gained from the closing acceleration until the impact */
     double gained = ip->closing * tau * dt;
@@ -177,12 +180,14 @@ static int pair_collide(carom_world *w, const contact_constraint *cc, impact_bod
             double d = total - lambda[j];
             lambda[j] = total;
             impulse_apply(B, A, ip->rb[j], ip->ra[j], v3_scale(ip->n, d));
+            if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
         }
     for (int j = 0; j < ip->count; j++) {
         ip->impulse += lambda[j];
         if (ip->mu > 0.0 && lambda[j] > 0.0)
             impulse_apply(B, A, ip->rb[j], ip->ra[j],
                           impulse_friction(B, A, ip->rb[j], ip->ra[j], ip->n, ip->mu, lambda[j], NULL));
+        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
     }
     /* what each body would not have travelled before the impact */
     double back = tau * dt;

@@ -217,6 +217,10 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->warm = cd->state;
     c->center_a = bs->center[sa];
     c->center_b = bs->center[sb];
+    c->lock_a = c->lock_b = v3_zero();
+    if (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE)) c->lock_a = bs->plane_normal[sa];
+    if (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE)) c->lock_b = bs->plane_normal[sb];
+    c->locked = v3_len2(c->lock_a) > 0.0 || v3_len2(c->lock_b) > 0.0;
     if (touching_impact(c, &bodies[c->a], &bodies[c->b], c->center_a, c->center_b, ctx->push_max)) {
         /* a touching pair driven together faster than the soft contact may
          * push out is stopped rigidly, as a speculative contact would be: a

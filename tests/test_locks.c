@@ -121,10 +121,135 @@ static void test_plane_lock_reduced_response(void **state)
             }
 }
 
+/* A box kept in the plane z = its start, sunk 2 % of its size into the
+ * ground (contact normal = plane normal): it cannot move along the normal,
+ * so nothing can push it out; its effective
+ * mass there is infinite, the contact gets no normal impulse and friction
+ * (mu N = 0) leaves its free spin exactly as it was: w_z = 2.5 after every
+ * step, for sizes, masses, time steps, presets and far from the origin. */
+static void test_plane_lock_contact_normal_along_lock(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const double sizes[] = {0.1, 0.5, 2.0}, masses[] = {1.0, 50.0}, dts[] = {1.0 / 15, 1.0 / 60, 1.0 / 1000};
+    const double offsets[] = {0, 1e5};
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            for (int o = 0; o < 2; o++) {
+                double he = sizes[k], mass = masses[(p + k) % 2], dt = dts[(p + 2 * k + o) % 3], x0 = offsets[o];
+                carom_world_def wd = carom_world_def_default();
+                assert_int_equal(carom_world_def_apply_preset(&wd, presets[p]), CAROM_OK);
+                wd.enable_sleep = 0;
+                carom_world *w = carom_world_create(&wd);
+                assert_non_null(w);
+                carom_body_def g = carom_body_def_default();
+                g.type = CAROM_BODY_STATIC;
+                g.shape = carom_shape_box(4.0 * he, 4.0 * he, he);
+                g.position = vec(x0, 0, -he);
+                g.friction = 0.6;
+                assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+                carom_body_def d = carom_body_def_default();
+                d.shape = carom_shape_box(he, he, he);
+                d.mass = mass;
+                d.friction = 0.6;
+                double z0 = 0.98 * he;
+                d.position = vec(x0, 0, z0);
+                d.angular_velocity = vec(0, 0, 2.5);
+                d.lock_to_plane = 1;
+                d.plane_normal = vec(0, 0, 1);
+                carom_body_id id = carom_body_create(w, &d);
+                assert_false(carom_body_id_is_null(id));
+                for (int st = 0; st < 30; st++) {
+                    assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+                    carom_vec3 av, v, c;
+                    assert_int_equal(carom_body_get_angular_velocity(w, id, &av), CAROM_OK);
+                    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
+                    assert_int_equal(carom_body_get_center_of_mass(w, id, &c), CAROM_OK);
+                    carom_contact_info info[4];
+                    int nc = carom_body_get_contacts(w, id, info, 4);
+                    assert_true(nc >= 0);
+                    double impulse = 0.0;
+                    for (int i = 0; i < nc && i < 4; i++) impulse += info[i].normal_impulse;
+                    if (st == 0 || st == 29)
+                        print_message("%s he %g m %g dt 1/%.0f x0 %g step %d: w_z %.15f, v_z %g, normal impulse %g (%d contacts)\n",
+                                      presets[p], he, mass, 1.0 / dt, x0, st + 1, av.z, v.z, impulse, nc);
+                    assert_true(nc >= 1); /* it is touching the ground... */
+                    assert_true(impulse == 0.0); /* ...which pushes it nowhere */
+                    assert_true(av.z == 2.5);
+                    assert_true(av.x == 0.0 && av.y == 0.0 && v.z == 0.0);
+                    assert_true(c.z == z0);
+                }
+                carom_world_destroy(w);
+            }
+}
+
+/* A ball kept in a tilted plane (unit normal l = (0, sin b, cos b)) lands on
+ * the ground (normal z) at e = 0 and mu = 0. Across the plane it cannot move,
+ * so an impulse J z changes its normal velocity by J (1 - cos^2 b) / m: the
+ * locked body's effective mass along z is m / sin^2 b (its arm r = -R z gives
+ * no turning). One rigid row at that mass stops the approach exactly: after
+ * each step with a relax pass (default, accurate) the normal velocity is 0 to
+ * rounding, and at every preset the velocity along l is 0; with the free
+ * mass m one row removes only sin^2 b of the approach. */
+static void test_plane_lock_effective_mass_in_contact(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const double tilts[] = {20.0, 45.0, 70.0}, dts[] = {1.0 / 15, 1.0 / 60, 1.0 / 1000};
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            for (int o = 0; o < 2; o++) {
+                double b = tilts[k] * 3.14159265358979323846 / 180.0, dt = dts[(p + k) % 3], x0 = o ? 1e5 : 0.0;
+                double mass = 3.0, radius = 0.25, v0 = 1.0, g = 9.81;
+                carom_vec3 l = vec(0, sin(b), cos(b));
+                carom_world_def wd = carom_world_def_default();
+                assert_int_equal(carom_world_def_apply_preset(&wd, presets[p]), CAROM_OK);
+                wd.enable_sleep = 0;
+                carom_world *w = carom_world_create(&wd);
+                assert_non_null(w);
+                carom_body_def gd = carom_body_def_default();
+                gd.type = CAROM_BODY_STATIC;
+                gd.shape = carom_shape_box(5, 5, 1);
+                gd.position = vec(x0, 0, -1);
+                gd.friction = 0.0;
+                assert_false(carom_body_id_is_null(carom_body_create(w, &gd)));
+                carom_body_def d = carom_body_def_default();
+                d.shape = carom_shape_sphere(radius);
+                d.mass = mass;
+                d.friction = 0.0;
+                d.restitution = 0.0;
+                d.position = vec(x0, 0, radius);
+                /* down the plane: the in-plane part of -z, at speed v0 */
+                carom_vec3 down = vec(0, l.z * l.y, -(1.0 - l.z * l.z));
+                double dl = sqrt(dot(down, down));
+                d.linear_velocity = vec(0, v0 * down.y / dl, v0 * down.z / dl);
+                d.lock_to_plane = 1;
+                d.plane_normal = l;
+                carom_body_id id = carom_body_create(w, &d);
+                assert_false(carom_body_id_is_null(id));
+                double sin2 = 1.0 - l.z * l.z;
+                for (int st = 0; st < 5; st++) {
+                    carom_vec3 v;
+                    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
+                    /* the approach it brings into the step, gravity's in-plane pull added */
+                    double vn_in = v.z - g * sin2 * dt;
+                    assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+                    assert_int_equal(carom_body_get_linear_velocity(w, id, &v), CAROM_OK);
+                    print_message("%s tilt %g dt 1/%.0f x0 %g step %d: v_n %.2e (in %.3f), v.l %.1e\n",
+                                  presets[p], tilts[k], 1.0 / dt, x0, st + 1, v.z, vn_in, dot(v, l));
+                    if (p > 0) assert_true(fabs(v.z) <= 1e-12); /* fast: no relax pass, the push-out stays */
+                    assert_true(fabs(dot(v, l)) <= 1e-15);
+                }
+                carom_world_destroy(w);
+            }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane_lock_reduced_response),
+        cmocka_unit_test(test_plane_lock_contact_normal_along_lock),
+        cmocka_unit_test(test_plane_lock_effective_mass_in_contact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
