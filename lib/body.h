@@ -36,12 +36,16 @@ typedef struct body_store {
     quat *rotation;
     vec3 *velocity, *angular_velocity;
     vec3 *force;                /* accumulated for the next step */
+    vec3 *torque;               /* world frame, accumulated for the next step (with force: BODY_HAS_FORCE) */
     vec3 *local_center;         /* centre of mass in the body frame */
     double *mass, *inv_mass;
     mat3 *inertia_local;        /* about the centre of mass, body axes */
     mat3 *inv_inertia_local;
     mat3 *inv_inertia_world;    /* kept current for the solver */
     double *friction, *restitution;
+    double *rolling_resistance; /* dimensionless (material.c) */
+    int *combine;               /* carom_combine_mode of the body's material */
+    double *force_threshold;    /* N: force events above it (0: none) */
     double *linear_damping, *angular_damping, *gravity_scale;
     vec3 *plane_normal;         /* lock_to_plane: unit normal */
     double *plane_offset;       /* lock_to_plane: dot(normal, centre) kept */

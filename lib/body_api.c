@@ -6,6 +6,7 @@
 #include <string.h>
 #include "array.h"
 #include "world.h"
+#include "material.h"
 #include "ranges.h"
 #include "shape_def.h"
 #include "mesh.h"
@@ -127,6 +128,8 @@ static int check_children(carom_world *w, const carom_body_def *d)
             CFAIL("body_create: children[%d].restitution must be in [0, 1]", i);
         if (!(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
             CFAIL("body_create: children[%d].density must be in [1e-6, 1e9] kg/m^3", i);
+        char msg[160];
+        if (c.material && !material_valid(c.material, msg, sizeof msg)) CFAIL("body_create: children[%d].%s", i, msg);
     }
     return 1;
 #undef CFAIL
@@ -169,6 +172,10 @@ static int check_body_def(carom_world *w, const carom_body_def *d)
         FAIL("body_create: gravity scale %g is outside [-1e4, 1e4]", d->gravity_scale);
     if (d->lock_to_plane && !normal_ok(d->plane_normal))
         FAIL("body_create: plane_normal must be finite with length >= 1e-12");
+    if (!(isfinite(d->force_threshold) && d->force_threshold >= 0))
+        FAIL("body_create: force_threshold must be finite and >= 0 (N; 0: no force events)");
+    char msg[160];
+    if (d->material && !material_valid(d->material, msg, sizeof msg)) FAIL("body_create: %s", msg);
 #undef FAIL
     if (d->shape.type == CAROM_SHAPE_COMPOUND) return check_children(w, d);
     return check_shape(w, &d->shape, d->type);
@@ -221,8 +228,11 @@ static int build_compound(carom_world *w, const carom_body_def *d, shape *sh)
         c->friction = malloc(sizeof *c->friction * (size_t)n);
         c->restitution = malloc(sizeof *c->restitution * (size_t)n);
         c->density = malloc(sizeof *c->density * (size_t)n);
+        c->rolling_resistance = malloc(sizeof *c->rolling_resistance * (size_t)n);
+        c->combine = malloc(sizeof *c->combine * (size_t)n);
     }
-    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density) {
+    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density || !c->rolling_resistance ||
+        !c->combine) {
         compound_free(c);
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
         return 0;
@@ -242,6 +252,10 @@ static int build_compound(carom_world *w, const carom_body_def *d, shape *sh)
         c->friction[i] = cd.friction;
         c->restitution[i] = cd.restitution;
         c->density[i] = cd.density;
+        c->rolling_resistance[i] = 0.0;
+        c->combine[i] = CAROM_COMBINE_DEFAULT;
+        if (cd.material)
+            material_apply(cd.material, &c->friction[i], &c->restitution[i], &c->rolling_resistance[i], &c->combine[i]);
     }
     sh->compound = c;
     return 1;
@@ -336,12 +350,18 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->velocity[slot] = d.type == CAROM_BODY_STATIC ? v3_zero() : to_v3(d.linear_velocity);
     s->angular_velocity[slot] = d.type == CAROM_BODY_STATIC || d.lock_rotation ? v3_zero() : to_v3(d.angular_velocity);
     s->force[slot] = v3_zero();
+    s->torque[slot] = v3_zero();
+    s->force_threshold[slot] = d.force_threshold;
     s->mass[slot] = mp.mass;
     s->inv_mass[slot] = dynamic ? 1.0 / mp.mass : 0.0;
     s->inertia_local[slot] = mp.inertia;
     s->inv_inertia_local[slot] = dynamic ? m3_inverse(mp.inertia) : m3_zero();
     s->friction[slot] = d.friction;
     s->restitution[slot] = d.restitution;
+    s->rolling_resistance[slot] = 0.0;
+    s->combine[slot] = CAROM_COMBINE_DEFAULT;
+    if (d.material) material_apply(d.material, &s->friction[slot], &s->restitution[slot], &s->rolling_resistance[slot],
+                                   &s->combine[slot]);
     s->linear_damping[slot] = d.linear_damping;
     s->angular_damping[slot] = d.angular_damping;
     s->gravity_scale[slot] = d.gravity_scale;

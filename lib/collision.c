@@ -6,6 +6,7 @@
 #include "array.h"
 #include "filter.h"
 #include "world.h"
+#include "material.h"
 #include "collision.h"
 #include "events.h"
 
@@ -41,12 +42,7 @@ static void add_pair(carom_world *w, int ida, int idb)
     if (w->pair_filter && !w->pair_filter(w->pair_filter_context, world_make_id(w, ida), world_make_id(w, idb))) return;
     int ci = contact_add(&w->contacts, ida, idb);
     if (ci < 0) return; /* out of memory: the pair is retried when a proxy moves again */
-    contact *c = &w->contacts.items[ci];
-    int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-    /* material mixing: friction sqrt(mu1 mu2), restitution max(e1, e2) */
-    contact_data *d = &w->contacts.data[ci];
-    d->friction = sqrt(s->friction[a] * s->friction[b]);
-    d->restitution = dmax(s->restitution[a], s->restitution[b]);
+    material_mix_contact(w, ci);
 }
 
 int world_update_pairs(carom_world *w, const step_context *ctx)
@@ -217,8 +213,7 @@ static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, do
         }
         contact *c = &cs->items[k];
         contact_data *d = &cs->data[k];
-        compound_sub_material(sha, shb, sub, s->friction[a], s->friction[b], s->restitution[a], s->restitution[b],
-                              &d->friction, &d->restitution);
+        material_mix_contact(w, k);
         manifold old_m = d->m;
         contact_point_state old_state[MANIFOLD_MAX_POINTS];
         memcpy(old_state, d->state, sizeof old_state);

@@ -12,6 +12,7 @@ void compound_free(compound *c)
     if (!c) return;
     for (int i = 0; i < c->count; i++) shape_free_data(&c->children[i]);
     free(c->children); free(c->poses); free(c->friction); free(c->restitution); free(c->density);
+    free(c->rolling_resistance); free(c->combine);
     free(c);
 }
 
@@ -147,16 +148,3 @@ void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *ch
     *child_b = b->type == SHAPE_COMPOUND ? (int)(pair % (uint32_t)nb) : -1;
 }
 
-void compound_sub_material(const shape *a, const shape *b, uint32_t sub, double body_friction_a, double body_friction_b,
-                           double body_restitution_a, double body_restitution_b, double *friction, double *restitution)
-{
-    int ia, ib;
-    compound_sub_children(a, b, sub, &ia, &ib);
-    double fa = ia >= 0 ? a->compound->friction[ia] : body_friction_a;
-    double fb = ib >= 0 ? b->compound->friction[ib] : body_friction_b;
-    double ra = ia >= 0 ? a->compound->restitution[ia] : body_restitution_a;
-    double rb = ib >= 0 ? b->compound->restitution[ib] : body_restitution_b;
-    /* the same mixing as for bodies: sqrt(mu1 mu2), max(e1, e2) */
-    *friction = sqrt(fa * fb);
-    *restitution = dmax(ra, rb);
-}

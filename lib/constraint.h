@@ -47,6 +47,10 @@ typedef struct contact_constraint {
      * bodies' velocities in their planes */
     vec3 lock_a, lock_b;
     int locked;
+    /* rolling resistance (material.c; 0: no rolling rows, the manifold may go wide): an
+     * angular row per tangent axis, capped at rolling * rolling_radius * normal impulse */
+    double rolling, rolling_radius;
+    double rolling_mass[2], rolling_impulse[2];
 } contact_constraint;
 
 /* ---- the shared formulas ------------------------------------------------ */

@@ -41,6 +41,7 @@ typedef struct contact {
 /* The manifold and warm-start state of a pair, at the same index. */
 typedef struct contact_data {
     double friction, restitution; /* mixed from the two bodies' materials */
+    double rolling_resistance;  /* mixed likewise (material.c) */
     manifold m;
     contact_point_state state[MANIFOLD_MAX_POINTS];
     vec3 tangent1;              /* friction basis kept across steps */

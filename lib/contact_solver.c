@@ -6,6 +6,52 @@
 
 #define TWO_PI 6.283185307179586
 
+/* Rolling resistance c: a torque against the bodies' relative rolling,
+ * capped at c R N. A body of mass m and inertia I_t about the rolling axis,
+ * its centre r above the contact, rolling on still ground slows at
+ * T r / (I_t + m r^2) under a torque T: R = r + I_t / (m r) makes that c g,
+ * as a block sliding with friction c would (the larger R of two bodies). */
+static void prepare_rolling(contact_constraint *c, const impulse_body *A, const impulse_body *B)
+{
+    c->rolling_impulse[0] = c->rolling_impulse[1] = 0.0;
+    c->rolling_mass[0] = c->rolling_mass[1] = 0.0;
+    c->rolling_radius = 0.0;
+    if (!(c->rolling > 0.0) || c->count < 1) return;
+    vec3 t[2] = {c->t1, c->t2};
+    for (int q = 0; q < 2; q++) {
+        double k = v3_dot(t[q], m3_mulv(A->inv_inertia, t[q])) + v3_dot(t[q], m3_mulv(B->inv_inertia, t[q]));
+        c->rolling_mass[q] = k > 0.0 ? 1.0 / k : 0.0;
+    }
+    vec3 mid = v3_zero();
+    for (int j = 0; j < c->count; j++) mid = v3_add(mid, c->m->points[j].point);
+    mid = v3_scale(mid, 1.0 / c->count);
+    const impulse_body *body[2] = {A, B};
+    vec3 centre[2] = {c->center_a, c->center_b};
+    for (int i = 0; i < 2; i++) {
+        const impulse_body *X = body[i];
+        double r = fabs(v3_dot(c->n, v3_sub(mid, centre[i])));
+        double inv_it = 0.5 * (v3_dot(t[0], m3_mulv(X->inv_inertia, t[0])) + v3_dot(t[1], m3_mulv(X->inv_inertia, t[1])));
+        if (!(X->inv_mass > 0.0 && inv_it > 0.0 && r > 0.0)) continue;
+        c->rolling_radius = dmax(c->rolling_radius, r + X->inv_mass / (inv_it * r));
+    }
+}
+
+static void solve_rolling(contact_constraint *c, vec3 *wA, vec3 *wB, const impulse_body *A, const impulse_body *B)
+{
+    double normal = 0.0;
+    for (int j = 0; j < c->count; j++) normal += c->p[j].normal_impulse;
+    vec3 rel = v3_sub(*wB, *wA);
+    double o1 = c->rolling_impulse[0], o2 = c->rolling_impulse[1];
+    double n1 = o1 - c->rolling_mass[0] * v3_dot(c->t1, rel);
+    double n2 = o2 - c->rolling_mass[1] * v3_dot(c->t2, rel);
+    coulomb_clamp(&n1, &n2, c->rolling * c->rolling_radius * normal);
+    c->rolling_impulse[0] = n1;
+    c->rolling_impulse[1] = n2;
+    vec3 L = v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2));
+    *wA = v3_sub(*wA, m3_mulv(A->inv_inertia, L));
+    *wB = v3_add(*wB, m3_mulv(B->inv_inertia, L));
+}
+
 double contact_prepare(contact_constraint *c, const step_context *ctx)
 {
     impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
@@ -62,6 +108,7 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         }
         if (-mp->separation > deepest) deepest = -mp->separation;
     }
+    prepare_rolling(c, A, B);
     return deepest;
 }
 
@@ -76,6 +123,11 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
         /* seed convention: body 1 = B receives +P (n points from A to B) */
         impulse_apply(B, A, p->rb, p->ra, P);
         if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+    }
+    if (c->rolling > 0.0) {
+        vec3 L = v3_add(v3_scale(c->t1, c->rolling_impulse[0]), v3_scale(c->t2, c->rolling_impulse[1]));
+        A->w = v3_sub(A->w, m3_mulv(A->inv_inertia, L));
+        B->w = v3_add(B->w, m3_mulv(B->inv_inertia, L));
     }
 }
 
@@ -143,6 +195,7 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
             dv = v3_sub(vB, vA);
         }
     }
+    if (c->rolling > 0.0) solve_rolling(c, &wA, &wB, A, B);
     A->v = vA; A->w = wA;
     B->v = vB; B->w = wB;
 }

@@ -37,6 +37,8 @@ void world_run_deferred_ops(carom_world *w)
         case DEFER_LINEAR_VELOCITY: carom_body_set_linear_velocity(w, op.id, op.value); break;
         case DEFER_ANGULAR_VELOCITY: carom_body_set_angular_velocity(w, op.id, op.value); break;
         case DEFER_FORCE: carom_body_apply_force(w, op.id, op.value); break;
+        case DEFER_TORQUE: carom_body_apply_torque(w, op.id, op.value); break;
+        case DEFER_FORCE_AT_POINT: carom_body_apply_force_at_point(w, op.id, op.value, op.point); break;
         }
     }
     s->deferred_op_count = 0;

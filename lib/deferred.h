@@ -11,7 +11,9 @@ typedef enum deferred_kind {
     DEFER_ANGULAR_IMPULSE,    /* carom_body_apply_angular_impulse */
     DEFER_LINEAR_VELOCITY,    /* carom_body_set_linear_velocity */
     DEFER_ANGULAR_VELOCITY,   /* carom_body_set_angular_velocity */
-    DEFER_FORCE               /* carom_body_apply_force: for the next step */
+    DEFER_FORCE,              /* carom_body_apply_force: for the next step */
+    DEFER_TORQUE,             /* carom_body_apply_torque: for the next step */
+    DEFER_FORCE_AT_POINT      /* carom_body_apply_force_at_point: for the next step */
 } deferred_kind;
 
 typedef struct deferred_op {

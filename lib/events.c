@@ -60,6 +60,19 @@ int events_hit(carom_world *w, int contact_index, int point, double normal_impul
     return push_event(w, &e, contact_index);
 }
 
+int events_force(carom_world *w, int contact_index, double normal_impulse, double force, vec3 point)
+{
+    const contact *c = &w->contacts.items[contact_index];
+    const contact_data *d = &w->contacts.data[contact_index];
+    carom_contact_event e;
+    event_pair(w, c, &e, CAROM_EVENT_FORCE);
+    e.point.x = point.x; e.point.y = point.y; e.point.z = point.z;
+    e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
+    e.normal_impulse = normal_impulse;
+    e.average_force = force;
+    return push_event(w, &e, contact_index);
+}
+
 int events_sensor(carom_world *w, carom_event_type type, carom_body_id sensor, carom_body_id other, carom_vec3 point)
 {
     carom_contact_event e;

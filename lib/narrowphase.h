@@ -61,8 +61,5 @@ int collide_multi(const shape *a, xform xa, const shape *b, xform xb, double spe
                   uint32_t *base, int max);
 /* The compound children a contact number `sub` of the pair belongs to (-1: not a compound). */
 void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *child_a, int *child_b);
-/* The mixed material of that contact: a compound child's own, else the body's. */
-void compound_sub_material(const shape *a, const shape *b, uint32_t sub, double body_friction_a, double body_friction_b,
-                           double body_restitution_a, double body_restitution_b, double *friction, double *restitution);
 
 #endif

@@ -37,6 +37,8 @@ typedef struct compound {
     struct shape *children;  /* convex, each in its own frame */
     xform *poses;            /* child frame in the body frame */
     double *friction, *restitution, *density;
+    double *rolling_resistance;  /* material.c */
+    int *combine;
 } compound;
 
 /* Meshes, height fields and compounds: contacts in several manifolds. */

@@ -442,6 +442,10 @@ static void write_world(writer *o, const carom_world *w)
         put_i32(o, s->group[i]);
         put_v3(o, s->previous_origin[i]);
         put_q(o, s->previous_rotation[i]);
+        put_v3(o, s->torque[i]);
+        put_f64(o, s->force_threshold[i]);
+        put_f64(o, s->rolling_resistance[i]);
+        put_u8(o, (unsigned)s->combine[i]);
         write_shape(o, &s->shapes[i]);
     }
 
@@ -464,6 +468,7 @@ static void write_world(writer *o, const carom_world *w)
         put_f64(o, c->reach_b);
         put_f64(o, d->friction);
         put_f64(o, d->restitution);
+        put_f64(o, d->rolling_resistance);
         put_v3(o, d->m.normal);
         put_u8(o, (unsigned)d->m.count);
         for (int k = 0; k < d->m.count; k++) {
@@ -604,6 +609,10 @@ static int read_bodies(reader *r, carom_world *w)
         s->group[i] = get_i32(r, what);
         s->previous_origin[i] = get_v3(r, what);
         s->previous_rotation[i] = get_q(r, what);
+        s->torque[i] = get_v3(r, what);
+        s->force_threshold[i] = get_f64(r, what);
+        s->rolling_resistance[i] = get_f64(r, what);
+        s->combine[i] = (int)get_u8(r, what);
         s->user_data[i] = NULL;
         s->proxy[i] = -1;
         if (r->failed) return 0;
@@ -628,6 +637,10 @@ static int read_bodies(reader *r, carom_world *w)
          * the mass then; set_mass may lower the mass later) */
         if (!(s->mass[i] >= 0) || !(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX))
             return bad(r, "body %d mass or force out of range", i);
+        if (!(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX && isfinite(s->force_threshold[i]) &&
+              s->force_threshold[i] >= 0 && s->rolling_resistance[i] >= 0 &&
+              s->rolling_resistance[i] <= RANGE_FRICTION_MAX && s->combine[i] <= CAROM_COMBINE_MAX))
+            return bad(r, "body %d torque, force threshold, rolling resistance or combine mode out of range", i);
         if (!(s->friction[i] >= 0 && s->friction[i] <= RANGE_FRICTION_MAX && s->restitution[i] >= 0 &&
               s->restitution[i] <= 1 && s->linear_damping[i] >= 0 && s->linear_damping[i] <= RANGE_DAMPING_MAX &&
               s->angular_damping[i] >= 0 && s->angular_damping[i] <= RANGE_DAMPING_MAX &&
@@ -699,13 +712,15 @@ static int read_contacts(reader *r, carom_world *w)
         c->reach_b = get_f64(r, "contact reach");
         d->friction = get_f64(r, "contact friction");
         d->restitution = get_f64(r, "contact restitution");
+        d->rolling_resistance = get_f64(r, "contact rolling resistance");
         d->m.normal = get_v3(r, "manifold normal");
         d->m.count = (int)get_u8(r, "manifold count");
         if (r->failed) return 0;
         if ((c->flags & ~(uint32_t)CONTACT_KNOWN_FLAGS) || c->cache.has_normal > 1 || c->cache.flip > 1 ||
             c->cache.feature < -1 || d->m.count > MANIFOLD_MAX_POINTS)
             return bad(r, "contact %d has unknown flags or a bad cache", i);
-        if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1))
+        if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
+              d->rolling_resistance >= 0 && d->rolling_resistance <= RANGE_FRICTION_MAX))
             return bad(r, "contact %d material out of range", i);
         for (int k = 0; k < d->m.count; k++) {
             d->m.points[k].point = get_v3(r, "manifold point");

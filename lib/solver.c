@@ -11,7 +11,7 @@
  *   check_penalty          explicit springs the sub-step cannot integrate refused
  *   resolve_impacts        impacts at the moment of contact (impact.c)
  *   per sub-step:
- *     integrate_velocities gravity, forces, damping
+ *     integrate_velocities gravity, forces, torques, damping
  *     warm_start           last step's impulses
  *     solve                biased passes, then the shock pass (penalty: springs)
  *     integrate_positions  centres and orientations
@@ -20,6 +20,7 @@
  *   finish_impacts         bounced bodies keep the rest of the step (impact.c)
  *   store_impulses         for next step's warm start
  *   raise_hit_events       impacts above the threshold
+ *   forces_raise_events    pairs pressed above a body's force threshold (forces.c)
  *   finish_bodies          velocities written back, clamps, NaN guard, inertia
  *
  * A new pass over the constraints plugs in as a stage here, with a scalar
@@ -35,6 +36,7 @@
 #include "rotation.h"
 #include "impact.h"
 #include "events.h"
+#include "forces.h"
 
 /* Below this many manifolds the wide passes gain nothing (mostly empty
  * lanes), and the scalar order converges faster on a small stack: colours
@@ -211,6 +213,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->t2 = v3_cross(c->n, t1);
     c->friction = cd->friction;
     c->restitution = ctx->restitution ? cd->restitution : 0.0;
+    c->rolling = ctx->friction ? cd->rolling_resistance : 0.0;
     c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? ctx->static_soft : ctx->soft;
     c->wide_batch = -1;
     c->m = &cd->m;
@@ -333,6 +336,8 @@ static void integrate_velocities(carom_world *w, const step_context *ctx)
         if (B->inv_mass == 0.0) continue; /* kinematic */
         vec3 acc = v3_madd(v3_scale(ctx->gravity, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
         B->v = v3_madd(B->v, h, acc);
+        /* a torque adds tau h to the angular momentum: w = I_start^-1 L as the solver keeps it */
+        if (bs->flags[slot] & BODY_HAS_FORCE) B->w = v3_madd(B->w, h, m3_mulv(B->inv_inertia, bs->torque[slot]));
         if (bs->linear_damping[slot] > 0) B->v = v3_scale(B->v, 1.0 / (1.0 + h * bs->linear_damping[slot]));
         if (bs->angular_damping[slot] > 0) B->w = v3_scale(B->w, 1.0 / (1.0 + h * bs->angular_damping[slot]));
     }
@@ -527,6 +532,7 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
         }
         if (bs->flags[slot] & BODY_HAS_FORCE) {
             bs->force[slot] = v3_zero();
+            bs->torque[slot] = v3_zero();
             bs->flags[slot] &= ~(uint32_t)BODY_HAS_FORCE;
         }
         /* (a plane-locked body turns about the plane normal only, and n.I n is
@@ -588,6 +594,7 @@ int world_solve(carom_world *w, step_context *ctx)
     finish_impacts(w, ctx, &work);
     store_impulses(w, ctx);
     raise_hit_events(w, ctx);
+    forces_raise_events(w, ctx->constraints, ctx->constraint_count, ctx->dt);
     finish_bodies(w, ctx, &work);
     return 1;
 }

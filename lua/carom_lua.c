@@ -353,6 +353,7 @@ CLUA_EXPORT int luaopen_carom(lua_State *L)
     clua_open_world(L);
     clua_open_body(L);
     clua_open_game(L);
+    clua_open_material(L);
     lua_pushcfunction(L, l_clock);
     lua_setfield(L, -2, "clock");
     lua_pushstring(L, carom_version());

@@ -17,6 +17,7 @@
 #define CLUA_WORLD_MT "carom.World"
 #define CLUA_BODY_MT "carom.Body"
 #define CLUA_SHAPE_MT "carom.Shape"
+#define CLUA_MATERIAL_MT "carom.Material"
 
 /* A world userdata. Its user values hold the Lua side of the world: */
 enum {
@@ -54,6 +55,7 @@ typedef struct clua_shape {
     carom_mesh_def mesh;               /* mesh: points over indices */
     carom_heightfield_def heightfield; /* heightfield: points and indices */
     carom_compound_child *children;    /* compound (owned; hull children's points in `points`) */
+    carom_material *materials;         /* compound: the children's materials (owned; children point here) */
     int child_count;
 } clua_shape;
 
@@ -132,5 +134,11 @@ void clua_open_body(lua_State *L);    /* metatable */
 void clua_open_game(lua_State *L);    /* wrap_game.c: filtering and query methods, after the two above */
 /* add_body's category/mask/group keys (wrap_game.c). */
 void clua_read_filter_keys(lua_State *L, int arg, const char *fname, carom_body_def *d);
+/* wrap_material.c: carom.material and the force and material body calls (after clua_open_body). */
+void clua_open_material(lua_State *L);
+/* add_body's material and force_threshold keys (the material stays referenced by the table at arg). */
+void clua_read_material_keys(lua_State *L, int arg, const char *fname, carom_body_def *d);
+/* The carom.Material at arg. */
+const carom_material *clua_check_material(lua_State *L, int arg, const char *fname);
 
 #endif

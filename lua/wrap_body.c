@@ -120,7 +120,7 @@ static const char *const body_keys[] = {
     "type", "shape", "position", "velocity", "orientation", "angular_velocity", "mass", "density",
     "restitution", "friction", "bullet", "lock_rotation", "lock_to_plane", "plane_normal", "gravity_scale",
     "damping", "linear_damping", "angular_damping", "sleep", "awake", "user_data", "data",
-    "category", "mask", "group", "sensor", NULL};
+    "category", "mask", "group", "sensor", "material", "force_threshold", NULL};
 
 int clua_world_add_body(lua_State *L)
 {
@@ -160,6 +160,7 @@ int clua_world_add_body(lua_State *L)
     clua_field_bool(L, 2, fname, "sleep", &d.enable_sleep);
     clua_field_bool(L, 2, fname, "awake", &d.awake);
     clua_read_filter_keys(L, 2, fname, &d);
+    clua_read_material_keys(L, 2, fname, &d);
     int has_user_data = clua_rawfield(L, 2, "user_data") != LUA_TNIL;
     int has_data = clua_rawfield(L, 2, "data") != LUA_TNIL;
     if (has_user_data && has_data) clua_arg_error(L, 2, fname, "give user_data or data (the same field), not both");
@@ -219,7 +220,6 @@ BODY_VEC_GETTER(local_center, carom_body_get_local_center)
 BODY_VEC_SETTER(set_position, carom_body_set_position)
 BODY_VEC_SETTER(set_velocity, carom_body_set_linear_velocity)
 BODY_VEC_SETTER(set_angular_velocity, carom_body_set_angular_velocity)
-BODY_VEC_SETTER(apply_force, carom_body_apply_force)
 
 #define BODY_NUMBER_GETTER(name, fn)                       \
     static int body_##name(lua_State *L)                   \
@@ -532,7 +532,7 @@ void clua_open_body(lua_State *L)
         {"local_center", body_local_center}, {"set_position", body_set_position},
         {"set_velocity", body_set_velocity}, {"set_angular_velocity", body_set_angular_velocity},
         {"set_orientation", body_set_orientation}, {"apply_impulse", body_apply_impulse},
-        {"apply_force", body_apply_force}, {"mass", body_mass}, {"set_mass", body_set_mass},
+        {"mass", body_mass}, {"set_mass", body_set_mass},
         {"inertia", body_inertia}, {"kinetic_energy", body_kinetic_energy}, {"friction", body_friction},
         {"set_friction", body_set_friction}, {"restitution", body_restitution},
         {"set_restitution", body_set_restitution}, {"set_gravity_scale", body_set_gravity_scale},

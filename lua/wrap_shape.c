@@ -333,7 +333,7 @@ static int l_heightfield(lua_State *L)
  * friction = 0.6, restitution = 0, density = 1000}, ... }: convex children */
 static int l_compound(lua_State *L)
 {
-    static const char *const child_keys[] = {"shape", "position", "orientation", "friction", "restitution", "density", NULL};
+    static const char *const child_keys[] = {"shape", "position", "orientation", "friction", "restitution", "density", "material", NULL};
     clua_check_table(L, 1, "compound");
     lua_settop(L, 1);
     lua_Integer n = (lua_Integer)lua_rawlen(L, 1);
@@ -363,8 +363,9 @@ static int l_compound(lua_State *L)
     clua_shape *s = new_shape(L);
     int self = lua_gettop(L);
     s->children = calloc((size_t)n, sizeof *s->children);
+    s->materials = calloc((size_t)n, sizeof *s->materials);
     s->points = malloc(sizeof *s->points * (total > 0 ? total : 1));
-    if (!s->children || !s->points) return luaL_error(L, "compound: out of memory");
+    if (!s->children || !s->points || !s->materials) return luaL_error(L, "compound: out of memory");
     size_t used = 0;
     for (lua_Integer i = 1; i <= n; i++) {
         char who[48];
@@ -389,6 +390,13 @@ static int l_compound(lua_State *L)
             clua_arg_error(L, ct, who, "restitution must be in [0, 1]");
         if (clua_field_number(L, ct, who, "density", &c.density) && !(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
             clua_arg_error(L, ct, who, "density must be in [1e-6, 1e9] kg/m^3");
+        if (clua_rawfield(L, ct, "material") != LUA_TNIL) {
+            const carom_material *m = luaL_testudata(L, -1, CLUA_MATERIAL_MT);
+            if (!m) clua_arg_error(L, ct, who, "material must be made by carom.material{...}, got %s", luaL_typename(L, -1));
+            s->materials[i - 1] = *m; /* the shape keeps its own copy */
+            c.material = &s->materials[i - 1];
+        }
+        lua_pop(L, 1);
         s->children[i - 1] = c;
         s->child_count = (int)i;
         lua_settop(L, self);
@@ -406,6 +414,8 @@ static int shape_gc(lua_State *L)
     free(s->points);
     free(s->indices);
     free(s->children);
+    free(s->materials);
+    s->materials = NULL;
     s->points = NULL;
     s->indices = NULL;
     s->children = NULL;

@@ -17,7 +17,7 @@ int clua_world_add_body(lua_State *L); /* wrap_body.c */
 static const char *const contact_models[] = {"impulse", "penalty", NULL};
 static const char *const corrections[] = {"soft", "baumgarte", "none", NULL};
 static const char *const presets[] = {"fast", "default", "accurate", NULL};
-static const char *const event_names[] = {"begin", "end", "hit", "sensor_begin", "sensor_end"};
+static const char *const event_names[] = {"begin", "end", "hit", "sensor_begin", "sensor_end", "force"};
 
 /* Plain numeric and boolean settings: Lua name -> field of carom_world_def. */
 typedef struct world_field {

@@ -332,6 +332,9 @@ typedef struct carom_compound_child {
     double friction;          /* 0.6 */
     double restitution;       /* 0 */
     double density;           /* 1000 kg/m^3 (the body's mass, when given, rescales all children) */
+    const struct carom_material *material; /* NULL: friction and restitution above; else copied from
+                                              it at creation (friction, restitution, rolling
+                                              resistance, combine) */
 } carom_compound_child;
 
 static inline carom_compound_child carom_compound_child_default(carom_shape_def shape)
@@ -344,6 +347,7 @@ static inline carom_compound_child carom_compound_child_default(carom_shape_def 
     c.friction = 0.6;
     c.restitution = 0.0;
     c.density = 1000.0;
+    c.material = 0;
     return c;
 }
 
@@ -385,6 +389,11 @@ typedef struct carom_body_def {
                                       bodies its filter allows as they start and stop overlapping it
                                       at the end of a step (static and sleeping ones included, other
                                       sensors not; a body crossing it within one step is not seen) */
+    double force_threshold;        /* 0: no force events; > 0 (N): a touching pair raises a FORCE
+                                      event each step its total normal force exceeds the lower
+                                      positive threshold of its two bodies */
+    const struct carom_material *material; /* NULL: friction and restitution above; else copied from
+                                              it at creation (see carom_material) */
 } carom_body_def;
 
 #define CAROM_MASK_ALL UINT64_MAX
@@ -421,6 +430,8 @@ static inline carom_body_def carom_body_def_default(void)
     d.mask = CAROM_MASK_ALL;
     d.group = 0;
     d.sensor = 0;
+    d.force_threshold = 0.0;
+    d.material = 0;
     return d;
 }
 
@@ -478,7 +489,11 @@ typedef enum carom_event_type {
     CAROM_EVENT_END = 1,     /* they stopped touching */
     CAROM_EVENT_HIT = 2,     /* an impact: approach speed above the restitution threshold */
     CAROM_EVENT_SENSOR_BEGIN = 3, /* body b started overlapping sensor a (see carom_body_def.sensor) */
-    CAROM_EVENT_SENSOR_END = 4    /* b stopped overlapping sensor a (or was destroyed: b is then stale) */
+    CAROM_EVENT_SENSOR_END = 4,   /* b stopped overlapping sensor a (or was destroyed: b is then stale) */
+    CAROM_EVENT_FORCE = 5         /* a touching pair pressed harder than a body's force_threshold:
+                                     average_force is the total normal force over the step (N),
+                                     normal_impulse its impulse, point the manifold's centre of
+                                     pressure, normal from a to b */
 } carom_event_type;
 
 struct carom_contact_event {
@@ -728,6 +743,68 @@ typedef struct carom_contact_info {
  * count; -1 on bad input. */
 CAROM_API int carom_body_get_contacts(const carom_world *world, carom_body_id id, carom_contact_info *contacts,
                                       int capacity);
+
+/* ---- forces, force events, materials ------------------------------------ */
+
+/* Adds a torque (N m, world frame) for the next step only: the body's
+ * angular momentum grows by torque * dt over it. Wakes the body; no effect
+ * on static, kinematic or rotation-locked bodies (a plane-locked body keeps
+ * the part about its plane normal). Deferred inside an event callback. */
+CAROM_API carom_status carom_body_apply_torque(carom_world *world, carom_body_id id, carom_vec3 torque);
+/* Adds a force (N) at a world point for the next step only: the force at the
+ * centre of mass and the torque (point - centre of mass) x force, the arm
+ * taken now. Deferred inside an event callback. */
+CAROM_API carom_status carom_body_apply_force_at_point(carom_world *world, carom_body_id id, carom_vec3 force,
+                                                       carom_vec3 point);
+/* The force and torque accumulated for the next step (zero after a step). */
+CAROM_API carom_status carom_body_get_applied_force(const carom_world *world, carom_body_id id, carom_vec3 *force,
+                                                    carom_vec3 *torque);
+/* See carom_body_def.force_threshold (>= 0, finite; 0 turns the events off). */
+CAROM_API carom_status carom_body_set_force_threshold(carom_world *world, carom_body_id id, double threshold);
+CAROM_API carom_status carom_body_get_force_threshold(const carom_world *world, carom_body_id id, double *out);
+
+/* How two materials mix into a contact's friction, restitution and rolling
+ * resistance. When the two bodies (or children) name different modes, the
+ * higher value below wins. */
+typedef enum carom_combine_mode {
+    CAROM_COMBINE_DEFAULT = 0,        /* friction sqrt(a b), restitution and rolling resistance max(a, b) */
+    CAROM_COMBINE_AVERAGE = 1,        /* (a + b) / 2 */
+    CAROM_COMBINE_GEOMETRIC_MEAN = 2, /* sqrt(a b) */
+    CAROM_COMBINE_MIN = 3,
+    CAROM_COMBINE_MULTIPLY = 4,       /* a b (restitution stays <= 1) */
+    CAROM_COMBINE_MAX = 5
+} carom_combine_mode;
+
+/* A surface material, referred to by body defs and compound children and
+ * copied into them at creation (or by carom_body_set_material). */
+typedef struct carom_material {
+    uint32_t size;                /* sizeof(carom_material), stamped by the default */
+    double friction;              /* 0.6 (Coulomb mu, 0..1000) */
+    double restitution;           /* 0 (0..1) */
+    double rolling_resistance;    /* 0 (0..1000): a body rolling on flat ground without slipping
+                                     slows at rolling_resistance * g (the resistance is a torque
+                                     about the contact, capped by the normal force; 0 rolls freely) */
+    carom_combine_mode combine;   /* DEFAULT */
+} carom_material;
+
+static inline carom_material carom_material_default(void)
+{
+    carom_material m;
+    m.size = (uint32_t)sizeof(carom_material);
+    m.friction = 0.6;
+    m.restitution = 0.0;
+    m.rolling_resistance = 0.0;
+    m.combine = CAROM_COMBINE_DEFAULT;
+    return m;
+}
+
+/* Checks a material; on error writes a readable message to msg (if not NULL). */
+CAROM_API carom_status carom_material_check(const carom_material *material, char *msg, size_t msg_size);
+/* Gives a body (all its children, for a compound) the material's values.
+ * Touching pairs take them from their next manifold. */
+CAROM_API carom_status carom_body_set_material(carom_world *world, carom_body_id id, const carom_material *material);
+/* The body's material (a compound: the body-level values). out->size must be set. */
+CAROM_API carom_status carom_body_get_material(const carom_world *world, carom_body_id id, carom_material *out);
 
 #ifdef __cplusplus
 }
