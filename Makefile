@@ -31,7 +31,8 @@ LUA_CFLAGS  = $(call once,LUA_CFLAGS,$(call pkg,--cflags,lua5.4,-I/usr/include/l
 LUA_LIBS    = $(call once,LUA_LIBS,$(call pkg,--libs,lua5.4,-llua5.4))
 CMOCKA_LIBS = $(call once,CMOCKA_LIBS,$(call pkg,--libs,cmocka,-lcmocka))
 # ccd's .pc lists -lm itself: link it once, last
-LDLIBS_ALL  = $(filter-out -lm,$(CCD_LIBS)) -lm
+# -pthread: the reference thread pool (lib/threads_posix.c)
+LDLIBS_ALL  = $(filter-out -lm,$(CCD_LIBS)) -lm -pthread
 
 # ---- install layout -------------------------------------------------------
 # LIBDIR: Debian's multiarch directory where the compiler has one (it is on
@@ -178,7 +179,7 @@ print-cflags:
 
 # ---- install --------------------------------------------------------------
 # Every file install writes, so that uninstall removes exactly those.
-INSTALLED = $(INCDIR)/carom/carom.h \
+INSTALLED = $(INCDIR)/carom/carom.h $(INCDIR)/carom/carom_threads.h \
     $(LIBDIR)/$(REALNAME) $(LIBDIR)/$(SONAME) $(LIBDIR)/libcarom.so $(LIBDIR)/libcarom.a \
     $(LIBDIR)/pkgconfig/carom.pc $(CMAKEDIR)/caromConfig.cmake $(CMAKEDIR)/caromConfigVersion.cmake \
     $(LUA_CMOD)/carom.so $(BINDIR)/carom-run $(MANDIR)/man1/carom-run.1 \
@@ -208,7 +209,7 @@ $(GEN)/caromConfigVersion.cmake: cmake/caromConfigVersion.cmake.in $(GEN)/layout
 install: all $(GEN)/carom.pc $(GEN)/caromConfig.cmake $(GEN)/caromConfigVersion.cmake
 	install -d $(DESTDIR)$(INCDIR)/carom $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(CMAKEDIR) \
 	    $(DESTDIR)$(BINDIR) $(DESTDIR)$(LUA_CMOD) $(DESTDIR)$(MANDIR)/man1 $(DESTDIR)$(DOCDIR)/examples
-	install -m 644 include/carom/carom.h $(DESTDIR)$(INCDIR)/carom/
+	install -m 644 include/carom/carom.h include/carom/carom_threads.h $(DESTDIR)$(INCDIR)/carom/
 	install -m 755 $(SHARED) $(DESTDIR)$(LIBDIR)/
 	ln -sf $(REALNAME) $(DESTDIR)$(LIBDIR)/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(LIBDIR)/libcarom.so

@@ -9,6 +9,7 @@
 #include "material.h"
 #include "collision.h"
 #include "events.h"
+#include "tasks.h"
 
 /* The broadphase reports pairs in the order its trees hold them, which
  * depends on their history; the pairs are added in (id, id) order instead, so
@@ -256,6 +257,60 @@ static int body_awake(const body_store *s, int slot)
     return s->type[slot] != CAROM_BODY_STATIC && (s->flags[slot] & BODY_AWAKE);
 }
 
+/* The narrowphase of a plain (not composite) pair: its manifold refreshed,
+ * kept, or known empty; returns 1 when it has points. ba, bb: the bounds the
+ * look-ahead is tested on; spec: the look-ahead. Reads and writes contact i
+ * alone (and reads the bodies), so pairs run in any order and at once. */
+static int narrow_contact(carom_world *w, int i, aabb ba, aabb bb, double spec, double reuse, int bounds_overlap)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    contact *c = &cs->items[i];
+    contact_data *d = &cs->data[i];
+    int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+    int awake_a = body_awake(s, a), awake_b = body_awake(s, b);
+    int touching = 0; /* known without reading the manifold where possible */
+    if (bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb)) {
+        xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
+        if (reuse_manifold(c, d, xa, xb, reuse)) {
+            touching = 1; /* kept: ids, impulses and feature cache stay as they were */
+        } else if (still_apart(c, xa, xb, spec)) {
+            touching = 0;
+        } else if (d->m.count == 0) {
+            /* most pairs near contact: nothing to carry over, nothing to copy */
+            manifold none;
+            none.count = 0;
+            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+            if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
+            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+            touching = d->m.count > 0;
+        } else {
+            manifold old_m = d->m;
+            contact_point_state old_state[MANIFOLD_MAX_POINTS];
+            memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
+            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
+            if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
+            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
+            touching = d->m.count > 0;
+        }
+    } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
+        d->m.count = 0;
+    }
+    return touching;
+}
+
+/* The look-ahead of a pair: a fast pair looks ahead by its closing travel this step. */
+static double pair_look_ahead(const carom_world *w, const step_context *ctx, int a, int b)
+{
+    const body_store *s = &w->bodies;
+    double speculative = w->def.speculative_distance;
+    double spec = speculative;
+    double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * ctx->dt;
+    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
+    return spec;
+}
+
 /* Refreshes the manifold(s) of contact i (a pair's own contact, sub 0, with
  * at least one body awake), raises its begin/end events, lists it as
  * touching and wakes a sleeping body it touches (counted in *woken). A pair
@@ -266,8 +321,6 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
-    double speculative = w->def.speculative_distance;
-    double dt = ctx->dt;
     contact *c = &cs->items[i];
     contact_data *d = &cs->data[i];
     int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
@@ -279,10 +332,7 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
         contact_remove(cs, i);
         return 0;
     }
-    /* a fast pair looks ahead by its closing travel this step */
-    double spec = speculative;
-    double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * dt;
-    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
+    double spec = pair_look_ahead(w, ctx, a, b);
     /* bounds farther apart than the look-ahead: no point can be within it
      * (the gap between boxes bounds the distance), so skip the narrowphase */
     aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
@@ -311,31 +361,11 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
         if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
         return 1;
     }
-    if (bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb)) {
-        xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-        if (reuse_manifold(c, d, xa, xb, reuse)) {
-            touching = 1; /* kept: ids, impulses and feature cache stay as they were */
-        } else if (still_apart(c, xa, xb, spec)) {
-            touching = 0;
-        } else if (d->m.count == 0) {
-            /* most pairs near contact: nothing to carry over, nothing to copy */
-            manifold none;
-            none.count = 0;
-            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-            if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
-            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-            touching = d->m.count > 0;
-        } else {
-            manifold old_m = d->m;
-            contact_point_state old_state[MANIFOLD_MAX_POINTS];
-            memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
-            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-            if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
-            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-            touching = d->m.count > 0;
-        }
-    } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
-        d->m.count = 0;
+    if (c->flags & CONTACT_PRECOMPUTED) {
+        touching = (c->flags & CONTACT_PRECOMPUTED_TOUCHING) != 0; /* precompute_manifolds did the work */
+        c->flags &= ~(uint32_t)(CONTACT_PRECOMPUTED | CONTACT_PRECOMPUTED_TOUCHING);
+    } else {
+        touching = narrow_contact(w, i, ba, bb, spec, reuse, bounds_overlap);
     }
     int was = (c->flags & CONTACT_TOUCHING) != 0;
     c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
@@ -349,6 +379,45 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
     else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
     if (touching) sc->touching[sc->touching_count++] = i;
     return 1;
+}
+
+/* Contacts per range handed to the task hooks. */
+#define CONTACT_MIN_RANGE 64
+
+typedef struct precompute_job {
+    carom_world *w;
+    const step_context *ctx;
+    double reuse;
+} precompute_job;
+
+/* The narrowphase of every plain pair whose outcome the ordered pass below
+ * cannot change: both bodies awake or static (waking only turns sleeping
+ * bodies awake, and the pass removes no pair that passes these tests), its
+ * filter bits allowing it and its bounds overlapping. The pass then takes
+ * each one's result from its flags instead of computing it. */
+static void precompute_range(int begin, int end, int worker, void *p)
+{
+    const precompute_job *j = p;
+    carom_world *w = j->w;
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    (void)worker;
+    for (int i = begin; i < end; i++) {
+        contact *c = &cs->items[i];
+        if (c->sub) continue;
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        int awake_a = body_awake(s, a), awake_b = body_awake(s, b);
+        if (!(awake_a || awake_b) || !(awake_a || s->type[a] == CAROM_BODY_STATIC) ||
+            !(awake_b || s->type[b] == CAROM_BODY_STATIC))
+            continue;
+        if (shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b])) continue;
+        if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || !filter_bits_allow(s, a, b)) continue;
+        double spec = pair_look_ahead(w, j->ctx, a, b);
+        aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
+        int touching = narrow_contact(w, i, ba, bb, spec, j->reuse, 1);
+        c->flags |= CONTACT_PRECOMPUTED | (touching ? CONTACT_PRECOMPUTED_TOUCHING : 0u);
+    }
 }
 
 int world_collide(carom_world *w, const step_context *ctx)
@@ -365,6 +434,8 @@ int world_collide(carom_world *w, const step_context *ctx)
     if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
     if (!array_reserve((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
         return 0;
+    precompute_job job = {w, ctx, reuse};
+    tasks_run(&w->def, cs->count, CONTACT_MIN_RANGE, precompute_range, &job);
     /* ascending, and a removal re-examines index i (the last contact, not yet
      * seen, moves there), so the indices already listed stay valid */
     int woken = 0;

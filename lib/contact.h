@@ -13,7 +13,11 @@ enum {
     CONTACT_SIM          = 1u << 2,   /* solved this step (both bodies not asleep) */
     CONTACT_REUSABLE     = 1u << 3,   /* rel_pose and the points' local_a/separation are valid */
     CONTACT_APART        = 1u << 4,   /* no manifold: rel_pose, gap and reach_b are valid */
-    CONTACT_ANY_TOUCHING = 1u << 5    /* sub 0 of a mesh pair: some manifold of the pair has points */
+    CONTACT_ANY_TOUCHING = 1u << 5,   /* sub 0 of a mesh pair: some manifold of the pair has points */
+    /* within the collision stage only (collision.c): the manifold was
+     * computed ahead, in parallel, and whether it has points */
+    CONTACT_PRECOMPUTED  = 1u << 6,
+    CONTACT_PRECOMPUTED_TOUCHING = 1u << 7
 };
 
 typedef struct contact_point_state {

@@ -230,9 +230,14 @@ static uint64_t checksum(const unsigned char *p, size_t n)
     F(max_linear_speed) F(max_angular_speed) I(body_capacity) F(contact_reuse_distance) F(hit_event_threshold)
 
 /* A field appended to carom_world_def must be added above (and to
- * docs/snapshot.md): this stops the build until it is. */
+ * docs/snapshot.md): this stops the build until it is. The task hooks
+ * (worker_count .. task_context, the last fields) are not written either:
+ * they belong to the writer's process, and a worker count without its
+ * hooks would be refused; a restored world runs on the calling thread until
+ * the host sets its own hooks. */
 typedef char snapshot_def_fields_cover_the_def
-    [offsetof(carom_world_def, hit_event_threshold) + sizeof(double) == sizeof(carom_world_def) ? 1 : -1];
+    [offsetof(carom_world_def, hit_event_threshold) + sizeof(double) == offsetof(carom_world_def, worker_count) &&
+     offsetof(carom_world_def, task_context) + sizeof(void *) == sizeof(carom_world_def) ? 1 : -1];
 
 static void write_def(writer *o, const carom_world_def *d)
 {

@@ -37,6 +37,7 @@
 #include "impact.h"
 #include "events.h"
 #include "forces.h"
+#include "tasks.h"
 
 /* Below this many manifolds the wide passes gain nothing (mostly empty
  * lanes), and the scalar order converges faster on a small stack: colours
@@ -326,11 +327,24 @@ static void prepare_points(const step_context *ctx, solver_work *work)
     }
 }
 
-static void integrate_velocities(carom_world *w, const step_context *ctx)
+/* Solver bodies per range handed to the task hooks. */
+#define BODY_MIN_RANGE 256
+
+/* A per-body loop's job: solver bodies 1 + begin .. 1 + end - 1. */
+typedef struct body_job {
+    carom_world *w;
+    const step_context *ctx;
+    const solver_work *work;
+} body_job;
+
+static void integrate_velocities_range(int begin, int end, int worker, void *p)
 {
-    const body_store *bs = &w->bodies;
+    const body_job *j = p;
+    const body_store *bs = &j->w->bodies;
+    const step_context *ctx = j->ctx;
     double h = ctx->h;
-    for (int b = 1; b < ctx->body_count; b++) {
+    (void)worker;
+    for (int b = 1 + begin; b < 1 + end; b++) {
         int slot = ctx->body_slot[b];
         impulse_body *B = &ctx->bodies[b];
         if (B->inv_mass == 0.0) continue; /* kinematic */
@@ -341,13 +355,19 @@ static void integrate_velocities(carom_world *w, const step_context *ctx)
         if (bs->linear_damping[slot] > 0) B->v = v3_scale(B->v, 1.0 / (1.0 + h * bs->linear_damping[slot]));
         if (bs->angular_damping[slot] > 0) B->w = v3_scale(B->w, 1.0 / (1.0 + h * bs->angular_damping[slot]));
     }
-    project_planar(bs, ctx);
+}
+
+static void integrate_velocities(carom_world *w, const step_context *ctx)
+{
+    body_job j = {w, ctx, NULL};
+    tasks_run(ctx->tasks, ctx->body_count - 1, BODY_MIN_RANGE, integrate_velocities_range, &j);
+    project_planar(&w->bodies, ctx);
 }
 
 static void warm_start(const step_context *ctx, const solver_work *work)
 {
     if (ctx->penalty || !ctx->warm_starting) return;
-    if (work->wide) wide_warm_start(work->wide, ctx->bodies);
+    if (work->wide) wide_warm_start(work->wide, ctx);
     for (int k = 0; k < work->scalar_count; k++) contact_warm_start(scalar_constraint(ctx, work, k), ctx->bodies);
 }
 
@@ -399,15 +419,18 @@ static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, 
     return wr;
 }
 
-static void integrate_positions(carom_world *w, const step_context *ctx, const solver_work *work)
+static void integrate_positions_range(int begin, int end, int worker, void *p)
 {
-    body_store *bs = &w->bodies;
+    const body_job *j = p;
+    body_store *bs = &j->w->bodies;
+    const step_context *ctx = j->ctx;
     double h = ctx->h;
-    for (int b = 1; b < ctx->body_count; b++) {
+    (void)worker;
+    for (int b = 1 + begin; b < 1 + end; b++) {
         int slot = ctx->body_slot[b];
         const impulse_body *B = &ctx->bodies[b];
         vec3 dx = v3_scale(B->v, h);
-        if (!work->in_contact[b] && B->inv_mass > 0.0 && !(bs->linear_damping[slot] > 0)) {
+        if (!j->work->in_contact[b] && B->inv_mass > 0.0 && !(bs->linear_damping[slot] > 0)) {
             /* in free flight the acceleration is constant over the sub-step: x += v0 h + a h^2 / 2
              * exactly (v = v0 + a h here), where semi-implicit Euler's v h flies an arc low by v h / 2 */
             vec3 acc = v3_madd(v3_scale(ctx->gravity, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
@@ -420,6 +443,12 @@ static void integrate_positions(carom_world *w, const step_context *ctx, const s
             ctx->dq[b] = v3_madd(ctx->dq[b], h, wr);
         }
     }
+}
+
+static void integrate_positions(carom_world *w, const step_context *ctx, const solver_work *work)
+{
+    body_job j = {w, ctx, work};
+    tasks_run(ctx->tasks, ctx->body_count - 1, BODY_MIN_RANGE, integrate_positions_range, &j);
 }
 
 /* The step's last relax pass holds bounces (see contact_solve) where the

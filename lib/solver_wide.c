@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "solver_wide.h"
+#include "tasks.h"
 
 #define LANES 4
 
@@ -61,15 +62,18 @@ struct wide_set {
     wide_batch *batches;
     wide_point *points;
     int *overflow;               /* constraints with no colour: scalar passes */
+    double *deepest;             /* per batch: its deepest overlap (prepare) */
     int batch_count, overflow_count;
+    int color_first[WIDE_COLORS + 1]; /* colour c's batches: color_first[c] .. color_first[c + 1] - 1 */
     int avx2;                    /* run the AVX2 build of the passes */
 };
 
-/* One build of the passes over every batch (WIDE_PASSES). */
+/* One build of the passes over the batches first .. last - 1 (WIDE_PASSES). */
 typedef struct wide_passes {
-    double (*prepare)(const wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm);
-    void (*warm)(const wide_set *ws, impulse_body *bodies);
-    void (*solve)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces);
+    void (*prepare)(const wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm, int first,
+                    int last);
+    void (*warm)(const wide_set *ws, impulse_body *bodies, int first, int last);
+    void (*solve)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first, int last);
 } wide_passes;
 
 static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
@@ -110,7 +114,7 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constra
     int max_wide_points = npoints / LANES + WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
     size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
                    align_up(sizeof(wide_point) * (size_t)max_wide_points) + align_up(sizeof(int) * (size_t)ncon) * 2 +
-                   align_up(sizeof(uint32_t) * (size_t)nb);
+                   align_up(sizeof(uint32_t) * (size_t)nb) + align_up(sizeof(double) * (size_t)max_batches);
     if (bytes > *capacity) {
         size_t cap = *capacity ? *capacity : 4096;
         while (cap < bytes) cap *= 2;
@@ -128,6 +132,8 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constra
     base += align_up(sizeof(wide_point) * (size_t)max_wide_points);
     ws->overflow = (int *)base;
     base += align_up(sizeof(int) * (size_t)ncon);
+    ws->deepest = (double *)base;
+    base += align_up(sizeof(double) * (size_t)max_batches);
     *color = (int *)base;
     base += align_up(sizeof(int) * (size_t)ncon);
     *used = (uint32_t *)base;
@@ -163,7 +169,8 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
 static void lay_out_batches(wide_set *ws, plan_buckets *pb)
 {
     int nbatch = 0, nwide = 0;
-    for (int c = 0; c < WIDE_COLORS; c++)
+    for (int c = 0; c < WIDE_COLORS; c++) {
+        ws->color_first[c] = nbatch;
         for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
             pb->start[c][n] = nbatch;
             int batches = (pb->count[c][n] + LANES - 1) / LANES;
@@ -182,6 +189,8 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb)
             nwide += batches * n;
             pb->count[c][n] = 0; /* now: lanes filled so far */
         }
+    }
+    ws->color_first[WIDE_COLORS] = nbatch;
     ws->batch_count = nbatch;
 }
 
@@ -608,27 +617,25 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
  * four lanes instead of two, and twice the registers). No FMA: rounding stays
  * the same in both builds, so results do not depend on the machine. */
 #define WIDE_PASSES(SUFFIX, TARGET)                                                                     \
-    TARGET static double prepare_batches##SUFFIX(const wide_set *ws, contact_constraint *cc,             \
-                                                 const impulse_body *bodies, double warm)                \
+    TARGET static void prepare_batches##SUFFIX(const wide_set *ws, contact_constraint *cc,               \
+                                               const impulse_body *bodies, double warm, int first, int last) \
     {                                                                                                    \
-        double deepest = 0.0;                                                                            \
-        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+        for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            deepest = dmax(deepest, prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm));        \
+            ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm);                \
         }                                                                                                \
-        return deepest;                                                                                  \
     }                                                                                                    \
-    TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies)                    \
+    TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies, int first, int last) \
     {                                                                                                    \
-        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+        for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
             warm_batch(wb, &ws->points[wb->first], bodies);                                              \
         }                                                                                                \
     }                                                                                                    \
     TARGET static void solve_batches##SUFFIX(const wide_set *ws, const step_context *ctx, int use_bias,  \
-                                             int hold_bounces)                                           \
+                                             int hold_bounces, int first, int last)                      \
     {                                                                                                    \
-        for (int k = 0; k < ws->batch_count; k++) {                                                      \
+        for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
             solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces);                        \
         }                                                                                                \
@@ -651,16 +658,72 @@ static const wide_passes *passes_for(const wide_set *ws)
     return &passes_base;
 }
 
-double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
+/* Batches per range handed to the task hooks: a range of a solve pass is a
+ * few microseconds of work, well above the cost of handing it over. */
+#define WIDE_MIN_RANGE 32
+
+/* One pass's job: the batches of the colour (or of all colours) in hand
+ * start at `offset`. */
+typedef struct wide_job {
+    const wide_set *ws;
+    const wide_passes *passes;
+    const step_context *ctx;
+    contact_constraint *cc;
+    int offset, use_bias, hold_bounces;
+} wide_job;
+
+static void prepare_range(int begin, int end, int worker, void *p)
 {
-    return passes_for(ws)->prepare(ws, cc, ctx->bodies, ctx->warm_starting ? 1.0 : 0.0);
+    const wide_job *j = p;
+    (void)worker;
+    j->passes->prepare(j->ws, j->cc, j->ctx->bodies, j->ctx->warm_starting ? 1.0 : 0.0, j->offset + begin,
+                       j->offset + end);
 }
 
-void wide_warm_start(const wide_set *ws, impulse_body *bodies) { passes_for(ws)->warm(ws, bodies); }
+static void warm_range(int begin, int end, int worker, void *p)
+{
+    const wide_job *j = p;
+    (void)worker;
+    j->passes->warm(j->ws, j->ctx->bodies, j->offset + begin, j->offset + end);
+}
+
+static void solve_range(int begin, int end, int worker, void *p)
+{
+    const wide_job *j = p;
+    (void)worker;
+    j->passes->solve(j->ws, j->ctx, j->use_bias, j->hold_bounces, j->offset + begin, j->offset + end);
+}
+
+/* Prepare reads the bodies and writes only its own batches: every batch at
+ * once. The deepest overlap is taken over the batches in order afterwards. */
+double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
+{
+    wide_job j = {ws, passes_for(ws), ctx, cc, 0, 0, 0};
+    tasks_run(ctx->tasks, ws->batch_count, WIDE_MIN_RANGE, prepare_range, &j);
+    double deepest = 0.0;
+    for (int k = 0; k < ws->batch_count; k++) deepest = dmax(deepest, ws->deepest[k]);
+    return deepest;
+}
+
+/* Warm start and solve write the bodies: colour by colour (no two batches of
+ * a colour share a moving body, so a colour's batches run in any order and
+ * at once with the same result as one after another). */
+void wide_warm_start(const wide_set *ws, const step_context *ctx)
+{
+    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, 0, 0};
+    for (int c = 0; c < WIDE_COLORS; c++) {
+        j.offset = ws->color_first[c];
+        tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, warm_range, &j);
+    }
+}
 
 void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces)
 {
-    passes_for(ws)->solve(ws, ctx, use_bias, hold_bounces);
+    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, use_bias, hold_bounces};
+    for (int c = 0; c < WIDE_COLORS; c++) {
+        j.offset = ws->color_first[c];
+        tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, solve_range, &j);
+    }
 }
 #else
 /* no vectors: no batches, every manifold is in the overflow */
@@ -669,7 +732,7 @@ double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_conte
     (void)ws; (void)cc; (void)ctx;
     return 0.0;
 }
-void wide_warm_start(const wide_set *ws, impulse_body *bodies) { (void)ws; (void)bodies; }
+void wide_warm_start(const wide_set *ws, const step_context *ctx) { (void)ws; (void)ctx; }
 void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces)
 {
     (void)ws; (void)ctx; (void)use_bias; (void)hold_bounces;

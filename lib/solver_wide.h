@@ -18,7 +18,7 @@ int wide_overflow(const wide_set *ws, const int **list);
  * contact_prepare does one; their scalar points get what the shock pass,
  * restitution and the events read. Returns the deepest overlap. */
 double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx);
-void wide_warm_start(const wide_set *ws, impulse_body *bodies);
+void wide_warm_start(const wide_set *ws, const step_context *ctx);
 /* use_bias: the solve pass, else relax; hold_bounces: see contact_solve. */
 void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces);
 /* Copies a batched constraint's current impulses to its scalar points (the

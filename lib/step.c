@@ -46,4 +46,5 @@ void step_context_init(step_context *ctx, const carom_world_def *def, double dt)
     ctx->penalty_stiffness = def->penalty_stiffness;
     ctx->penalty_damping = def->penalty_damping;
     ctx->gravity = v3(def->gravity.x, def->gravity.y, def->gravity.z);
+    ctx->tasks = def;
 }

@@ -41,6 +41,7 @@ typedef struct step_context {
     int penalty_implicit;
     double penalty_stiffness, penalty_damping;
     vec3 gravity;
+    const carom_world_def *tasks; /* the world's task hooks (tasks.h) */
     /* solver bodies (the solver's gather stage): index 0 is the shared
      * immovable body */
     impulse_body *bodies;

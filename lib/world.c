@@ -108,6 +108,13 @@ static int def_validate(const carom_world_def *d, char *msg, size_t n)
     REQUIRE(isfinite(d->contact_reuse_distance) && d->contact_reuse_distance >= 0 && d->contact_reuse_distance <= 0.01,
             "contact_reuse_distance must be in [0, 0.01] m");
     REQUIRE(d->body_capacity >= 0 && d->body_capacity <= (1 << 26), "body_capacity must be in 0..2^26");
+    REQUIRE(d->worker_count >= 1 && d->worker_count <= CAROM_MAX_WORKERS, "worker_count must be in 1..%d (got %d)",
+            CAROM_MAX_WORKERS, d->worker_count);
+    REQUIRE(d->worker_count == 1 || d->enqueue_task,
+            "worker_count is %d but enqueue_task is NULL: set the task hooks (carom_threads.h has a pool) or use 1 worker",
+            d->worker_count);
+    REQUIRE(!d->enqueue_task == !d->finish_task, "enqueue_task and finish_task must be set together (%s is NULL)",
+            d->enqueue_task ? "finish_task" : "enqueue_task");
 #undef REQUIRE
     return 1;
 }

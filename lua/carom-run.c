@@ -1,6 +1,6 @@
 /* carom-run - plays a Lua scene headless at a fixed step.
  *
- *   carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]
+ *   carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K] [--threads N]
  *                       [--bench] [--record FILE.csv] [--quiet]
  *   carom-run --test script.lua
  *   carom-run --version
@@ -70,6 +70,7 @@ static const char driver_setup[] =
     "local wopts = {}\n"
     "for k, v in pairs(scene.world or {}) do wopts[k] = v end\n"
     "if opts.substeps then wopts.substeps = opts.substeps end\n"
+    "if opts.threads then wopts.threads = opts.threads end\n"
     "local made, world = pcall(carom.world, wopts)\n"
     "if not made then\n"
     "  local why = tostring(world):gsub('^bad argument #1 to \\'[%w.]*\\' %((.*)%)$', '%1')\n"
@@ -147,13 +148,14 @@ static const char driver_loop[] =
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K]\n"
+    fprintf(f, "usage: carom-run scene.lua [--steps N | --seconds S] [--dt DT] [--substeps K] [--threads N]\n"
                "                           [--bench] [--record FILE.csv] [--quiet]\n"
                "       carom-run --test script.lua | --version | --help\n"
                "  --steps N      run N steps (default: the scene's `steps`, else 600)\n"
                "  --seconds S    run S seconds of simulated time\n"
                "  --dt DT        the fixed step in seconds, 0 < DT <= 1 (default: the scene's `dt`, else 1/60)\n"
                "  --substeps K   sub-steps per step, 1..64 (overrides the scene's world options)\n"
+               "  --threads N    step on N threads, 1..64 (the reference pool; same results)\n"
                "  --bench        print the median ms/step and the accuracy probes at the end\n"
                "  --record FILE  write every body's pose after every step as CSV\n"
                "                 (step,t,body,x,y,z,qw,qx,qy,qz)\n"
@@ -215,7 +217,7 @@ int main(int argc, char **argv)
 {
     const char *scene = NULL, *record = NULL, *test = NULL;
     /* NAN: not given on the command line */
-    double steps = NAN, seconds = NAN, dt = NAN, substeps = NAN;
+    double steps = NAN, seconds = NAN, dt = NAN, substeps = NAN, threads = NAN;
     int bench = 0, quiet = 0, scene_options = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -230,6 +232,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--seconds")) target = &seconds;
         else if (!strcmp(a, "--dt")) target = &dt;
         else if (!strcmp(a, "--substeps")) target = &substeps;
+        else if (!strcmp(a, "--threads")) target = &threads;
         else if (!strcmp(a, "--bench")) {
             bench = scene_options = 1;
             continue;
@@ -274,6 +277,8 @@ int main(int argc, char **argv)
     if (!isnan(seconds) && seconds / (isnan(dt) ? 1.0 / 60.0 : dt) > 1e9) return bad_usage("--seconds / --dt is more than 1e9 steps");
     if (!isnan(substeps) && !(substeps >= 1 && substeps <= 64 && substeps == floor(substeps)))
         return bad_usage("--substeps must be a whole number from 1 to 64");
+    if (!isnan(threads) && !(threads >= 1 && threads <= 64 && threads == floor(threads)))
+        return bad_usage("--threads must be a whole number from 1 to 64");
 
     lua_State *L = luaL_newstate();
     if (!L) {
@@ -324,6 +329,10 @@ int main(int argc, char **argv)
             if (!isnan(substeps)) {
                 lua_pushinteger(L, (lua_Integer)substeps);
                 lua_setfield(L, -2, "substeps");
+            }
+            if (!isnan(threads)) {
+                lua_pushinteger(L, (lua_Integer)threads);
+                lua_setfield(L, -2, "threads");
             }
             lua_pushboolean(L, bench);
             lua_setfield(L, -2, "bench");

@@ -13,6 +13,7 @@
 #include <lua.h>
 #include <lauxlib.h>
 #include "carom/carom.h"
+#include "carom/carom_threads.h"
 
 #define CLUA_WORLD_MT "carom.World"
 #define CLUA_BODY_MT "carom.Body"
@@ -38,6 +39,7 @@ typedef struct clua_world {
     double fixed_dt;        /* advance(): the fixed step */
     double accumulator;     /* advance(): time not yet simulated */
     int max_steps;          /* advance(): steps per call before the backlog is dropped */
+    carom_thread_pool *pool; /* the world option threads = N > 1: its own pool, or NULL */
 } clua_world;
 
 /* A body userdata: the id only; its single user value is its world's userdata,

@@ -64,7 +64,7 @@ static const char *const world_keys[] = {
     "damping_ratio", "push_velocity", "baumgarte", "linear_slop", "speculative_distance",
     "reuse_distance", "penalty_stiffness", "penalty_damping", "penalty_implicit", "shock_propagation", "friction",
     "restitution", "sleep", "ccd", "sleep_time", "sleep_linear_velocity", "sleep_angular_velocity",
-    "max_linear_speed", "max_angular_speed", "body_capacity", NULL};
+    "max_linear_speed", "max_angular_speed", "body_capacity", "threads", NULL};
 
 #define DEFAULT_MAX_STEPS 8
 
@@ -79,7 +79,7 @@ clua_world *clua_check_world(lua_State *L, int arg, const char *fname)
 /* Reads the options table at arg over *def (preset first, then explicit keys,
  * which win) and the advance() settings; changes nothing on error. */
 static void read_world_options(lua_State *L, int arg, const char *fname, carom_world_def *def, double *fixed_dt,
-                               int *max_steps)
+                               int *max_steps, int *threads)
 {
     clua_check_table(L, arg, fname);
     clua_check_keys(L, arg, fname, world_keys);
@@ -105,6 +105,9 @@ static void read_world_options(lua_State *L, int arg, const char *fname, carom_w
     int ms = *max_steps;
     if (clua_field_int(L, arg, fname, "max_steps", &ms) && !(ms >= 1 && ms <= 100000))
         clua_arg_error(L, arg, fname, "max_steps must be in 1..100000");
+    int th = *threads;
+    if (clua_field_int(L, arg, fname, "threads", &th) && !(th >= 1 && th <= CAROM_MAX_WORKERS))
+        clua_arg_error(L, arg, fname, "threads must be in 1..%d", CAROM_MAX_WORKERS);
     char msg[256];
     if (carom_world_def_check(&d, msg, sizeof msg) != CAROM_OK) {
         const char *colon = strstr(msg, ": ");
@@ -113,6 +116,22 @@ static void read_world_options(lua_State *L, int arg, const char *fname, carom_w
     *def = d;
     *fixed_dt = dt;
     *max_steps = ms;
+    *threads = th;
+}
+
+/* The reference pool for threads = N (N > 1) attached to *def, or the hooks
+ * cleared for 1; *pool is the new pool (NULL for 1). 0 when the threads
+ * cannot be started. */
+static int make_pool(int threads, carom_world_def *def, carom_thread_pool **pool)
+{
+    *pool = NULL;
+    def->worker_count = 1;
+    def->enqueue_task = NULL;
+    def->finish_task = NULL;
+    def->task_context = NULL;
+    if (threads <= 1) return 1;
+    *pool = carom_thread_pool_create(threads);
+    return *pool && carom_thread_pool_attach(*pool, def) == CAROM_OK;
 }
 
 static void world_event_callback(void *context, const carom_contact_event *event);
@@ -123,14 +142,23 @@ static int l_world(lua_State *L)
 {
     carom_world_def d = carom_world_def_default();
     double fixed_dt = 1.0 / 60.0;
-    int max_steps = DEFAULT_MAX_STEPS;
-    if (!lua_isnoneornil(L, 1)) read_world_options(L, 1, "world", &d, &fixed_dt, &max_steps);
+    int max_steps = DEFAULT_MAX_STEPS, threads = 1;
+    if (!lua_isnoneornil(L, 1)) read_world_options(L, 1, "world", &d, &fixed_dt, &max_steps, &threads);
     lua_settop(L, 0);
     clua_world *lw = push_world_userdata(L, fixed_dt, max_steps);
     d.event_callback = world_event_callback;
     d.event_context = lw;
+    if (!make_pool(threads, &d, &lw->pool)) {
+        carom_thread_pool_destroy(lw->pool);
+        lw->pool = NULL;
+        return luaL_error(L, "world: could not start %d threads", threads);
+    }
     lw->world = carom_world_create(&d);
-    if (!lw->world) return luaL_error(L, "world: could not create the world (out of memory)");
+    if (!lw->world) {
+        carom_thread_pool_destroy(lw->pool);
+        lw->pool = NULL;
+        return luaL_error(L, "world: could not create the world (out of memory)");
+    }
     return 1;
 }
 
@@ -213,14 +241,25 @@ static int world_configure(lua_State *L)
     carom_world_get_def(lw->world, &d);
     double fixed_dt = lw->fixed_dt;
     int max_steps = lw->max_steps;
-    read_world_options(L, 2, "configure", &d, &fixed_dt, &max_steps);
+    int old_threads = lw->pool ? carom_thread_pool_workers(lw->pool) : 1, threads = old_threads;
+    read_world_options(L, 2, "configure", &d, &fixed_dt, &max_steps, &threads);
     d.event_callback = world_event_callback;
     d.event_context = lw;
     lw = clua_check_world(L, 1, "configure");
     if (lw->stepping) return luaL_error(L, "configure: cannot change settings inside a contact callback");
+    carom_thread_pool *pool = lw->pool;
+    if (threads != old_threads && !make_pool(threads, &d, &pool)) {
+        carom_thread_pool_destroy(pool);
+        return luaL_error(L, "configure: could not start %d threads", threads);
+    }
     if (carom_world_set_def(lw->world, &d) != CAROM_OK) {
+        if (pool != lw->pool) carom_thread_pool_destroy(pool);
         char buf[256];
         return luaL_error(L, "configure: %s", clua_copy_error(lw->world, buf, sizeof buf));
+    }
+    if (pool != lw->pool) {
+        carom_thread_pool_destroy(lw->pool); /* the world no longer uses it */
+        lw->pool = pool;
     }
     if (fixed_dt != lw->fixed_dt) lw->accumulator = 0;
     lw->fixed_dt = fixed_dt;
@@ -252,6 +291,8 @@ static int world_settings(lua_State *L)
     lua_setfield(L, -2, "dt");
     lua_pushinteger(L, lw->max_steps);
     lua_setfield(L, -2, "max_steps");
+    lua_pushinteger(L, lw->pool ? carom_thread_pool_workers(lw->pool) : 1);
+    lua_setfield(L, -2, "threads");
     return 1;
 }
 
@@ -265,6 +306,8 @@ static int world_destroy_impl(lua_State *L, const char *fname, int quiet)
     }
     carom_world_destroy(lw->world);
     lw->world = NULL;
+    carom_thread_pool_destroy(lw->pool); /* after the world that used it */
+    lw->pool = NULL;
     lw->has_callback = 0;
     /* the Lua side goes with it: bodies now report "world has been destroyed" */
     for (int uv = WORLD_UV_IDS; uv <= WORLD_UV_ERROR; uv++) {

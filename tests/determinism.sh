@@ -12,7 +12,7 @@ command -v clang >/dev/null || { echo "determinism: clang is needed (apt-get ins
 out=build/determinism
 mkdir -p $out
 common="-std=c99 -Wall -Wextra -Werror -g -ffp-contract=off -DCAROM_BUILDING -Iinclude -Ilib $(pkg-config --cflags ccd 2>/dev/null || true)"
-libs="$(pkg-config --libs ccd 2>/dev/null || echo -lccd) -lm"
+libs="$(pkg-config --libs ccd 2>/dev/null || echo -lccd) -lm -pthread"
 for cc in gcc clang; do
   for opt in -O1 -O2; do
     extra=""

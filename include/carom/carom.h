@@ -99,6 +99,24 @@ typedef struct carom_contact_event carom_contact_event;
  * is deferred to the end of the step, other setters are refused. */
 typedef void carom_event_fn(void *context, const carom_contact_event *event);
 
+/* Threads through the host's own job system (carom_world_def's task hooks).
+ * The library hands the host a task over items 0 .. item_count-1; the host
+ * runs it as ranges task(begin, end, worker, task_data) with
+ * 0 <= begin < end <= item_count, every item in exactly one range, each range
+ * at least min_range items long except possibly the last, on workers
+ * 0 .. worker_count-1 (two ranges running at the same time never share a
+ * worker index). The results do not depend on how the items are split or on
+ * the order the ranges run in: they are bitwise the same as on one thread.
+ * carom_threads.h has a reference implementation on POSIX threads. */
+typedef void carom_task_fn(int begin, int end, int worker, void *task_data);
+/* Starts a task; returns a handle for finish_task, or NULL when every range
+ * has already run (a host may run a task inline). */
+typedef void *carom_enqueue_task_fn(carom_task_fn *task, int item_count, int min_range, void *task_data,
+                                    void *task_context);
+/* Returns once every range of the task enqueue_task started has run. */
+typedef void carom_finish_task_fn(void *task, void *task_context);
+#define CAROM_MAX_WORKERS 64
+
 typedef struct carom_world_def {
     uint32_t size;                      /* sizeof(carom_world_def), stamped by the default */
     carom_vec3 gravity;                 /* (0, 0, -9.81) */
@@ -143,6 +161,11 @@ typedef struct carom_world_def {
                                            speculative_distance; 0 = recompute every step */
     double hit_event_threshold;         /* 1.0 m/s: a contact approaching faster raises a hit
                                            event (restitution_threshold only decides bounces) */
+    int worker_count;                   /* 1: workers the task hooks run ranges on, 1..CAROM_MAX_WORKERS
+                                           (more than 1 needs enqueue_task) */
+    carom_enqueue_task_fn *enqueue_task; /* NULL: every stage runs on the calling thread */
+    carom_finish_task_fn *finish_task;  /* NULL: only with enqueue_task NULL */
+    void *task_context;                 /* passed to both hooks */
 } carom_world_def;
 
 static inline carom_world_def carom_world_def_default(void)
@@ -181,6 +204,10 @@ static inline carom_world_def carom_world_def_default(void)
     d.event_context = 0;
     d.contact_reuse_distance = 1e-4;
     d.hit_event_threshold = 1.0;
+    d.worker_count = 1;
+    d.enqueue_task = 0;
+    d.finish_task = 0;
+    d.task_context = 0;
     return d;
 }
 

@@ -1,0 +1,168 @@
+/* threads_posix.c - the reference task hooks (carom_threads.h): a pool of
+ * POSIX threads. A task is cut into at most four ranges per worker (fewer
+ * when min_range asks for longer ones); workers and the thread waiting in
+ * finish claim them one at a time under the pool's lock. */
+#define _POSIX_C_SOURCE 200809L
+#include <pthread.h>
+#include <stdlib.h>
+#include "carom/carom_threads.h"
+
+#define RANGES_PER_WORKER 4
+
+struct carom_thread_pool {
+    int workers;
+    int threads_started;
+    pthread_t threads[CAROM_MAX_WORKERS];
+    pthread_mutex_t lock;
+    pthread_cond_t work_ready;   /* a task was enqueued, or stop */
+    pthread_cond_t work_done;    /* the last range of the task finished */
+    /* the task in flight (busy), under lock */
+    carom_task_fn *task;
+    void *task_data;
+    int item_count, range_size, range_count;
+    int next_range, done_ranges;
+    int busy, stop;
+};
+
+/* Claims and runs ranges of the task in flight until none is left; called
+ * and returns with the lock held. */
+static void work_on_task(carom_thread_pool *p, int worker)
+{
+    while (p->busy && p->next_range < p->range_count) {
+        int r = p->next_range++;
+        int begin = r * p->range_size;
+        int end = begin + p->range_size < p->item_count ? begin + p->range_size : p->item_count;
+        carom_task_fn *task = p->task;
+        void *data = p->task_data;
+        pthread_mutex_unlock(&p->lock);
+        task(begin, end, worker, data);
+        pthread_mutex_lock(&p->lock);
+        if (++p->done_ranges == p->range_count) pthread_cond_signal(&p->work_done);
+    }
+}
+
+typedef struct worker_start {
+    carom_thread_pool *pool;
+    int worker;
+} worker_start;
+
+static void *worker_main(void *arg)
+{
+    worker_start *start = arg;
+    carom_thread_pool *p = start->pool;
+    int worker = start->worker;
+    free(start);
+    pthread_mutex_lock(&p->lock);
+    for (;;) {
+        while (!p->stop && !(p->busy && p->next_range < p->range_count)) pthread_cond_wait(&p->work_ready, &p->lock);
+        if (p->stop) break;
+        work_on_task(p, worker);
+    }
+    pthread_mutex_unlock(&p->lock);
+    return NULL;
+}
+
+CAROM_API carom_thread_pool *carom_thread_pool_create(int workers)
+{
+    if (workers < 1 || workers > CAROM_MAX_WORKERS) return NULL;
+    carom_thread_pool *p = calloc(1, sizeof *p);
+    if (!p) return NULL;
+    p->workers = workers;
+    if (pthread_mutex_init(&p->lock, NULL) != 0) { free(p); return NULL; }
+    if (pthread_cond_init(&p->work_ready, NULL) != 0) {
+        pthread_mutex_destroy(&p->lock);
+        free(p);
+        return NULL;
+    }
+    if (pthread_cond_init(&p->work_done, NULL) != 0) {
+        pthread_cond_destroy(&p->work_ready);
+        pthread_mutex_destroy(&p->lock);
+        free(p);
+        return NULL;
+    }
+    for (int k = 1; k < workers; k++) {
+        worker_start *start = malloc(sizeof *start);
+        if (!start) break;
+        start->pool = p;
+        start->worker = k;
+        if (pthread_create(&p->threads[p->threads_started], NULL, worker_main, start) != 0) {
+            free(start);
+            break;
+        }
+        p->threads_started++;
+    }
+    if (p->threads_started != workers - 1) {
+        carom_thread_pool_destroy(p);
+        return NULL;
+    }
+    return p;
+}
+
+CAROM_API void carom_thread_pool_destroy(carom_thread_pool *p)
+{
+    if (!p) return;
+    pthread_mutex_lock(&p->lock);
+    p->stop = 1;
+    pthread_cond_broadcast(&p->work_ready);
+    pthread_mutex_unlock(&p->lock);
+    for (int k = 0; k < p->threads_started; k++) pthread_join(p->threads[k], NULL);
+    pthread_cond_destroy(&p->work_done);
+    pthread_cond_destroy(&p->work_ready);
+    pthread_mutex_destroy(&p->lock);
+    free(p);
+}
+
+CAROM_API int carom_thread_pool_workers(const carom_thread_pool *p)
+{
+    return p ? p->workers : 0;
+}
+
+CAROM_API carom_status carom_thread_pool_attach(carom_thread_pool *p, carom_world_def *def)
+{
+    if (!p || !def || def->size < offsetof(carom_world_def, task_context) + sizeof(void *))
+        return CAROM_ERROR_INVALID_ARGUMENT;
+    def->worker_count = p->workers;
+    def->enqueue_task = carom_thread_pool_enqueue;
+    def->finish_task = carom_thread_pool_finish;
+    def->task_context = p;
+    return CAROM_OK;
+}
+
+CAROM_API void *carom_thread_pool_enqueue(carom_task_fn *task, int item_count, int min_range, void *task_data,
+                                          void *pool)
+{
+    carom_thread_pool *p = pool;
+    if (item_count <= 0) return NULL;
+    if (min_range < 1) min_range = 1;
+    pthread_mutex_lock(&p->lock);
+    if (p->busy || p->workers == 1) {
+        /* one task at a time: this one runs here, now */
+        pthread_mutex_unlock(&p->lock);
+        task(0, item_count, 0, task_data);
+        return NULL;
+    }
+    int ranges = (item_count + min_range - 1) / min_range;
+    if (ranges > RANGES_PER_WORKER * p->workers) ranges = RANGES_PER_WORKER * p->workers;
+    p->task = task;
+    p->task_data = task_data;
+    p->item_count = item_count;
+    p->range_size = (item_count + ranges - 1) / ranges;
+    p->range_count = (item_count + p->range_size - 1) / p->range_size;
+    p->next_range = 0;
+    p->done_ranges = 0;
+    p->busy = 1;
+    pthread_cond_broadcast(&p->work_ready);
+    pthread_mutex_unlock(&p->lock);
+    return p;
+}
+
+CAROM_API void carom_thread_pool_finish(void *task, void *pool)
+{
+    carom_thread_pool *p = pool;
+    if (!task) return;
+    pthread_mutex_lock(&p->lock);
+    work_on_task(p, 0); /* the waiting thread is worker 0 */
+    while (p->done_ranges < p->range_count) pthread_cond_wait(&p->work_done, &p->lock);
+    p->busy = 0;
+    pthread_mutex_unlock(&p->lock);
+}
