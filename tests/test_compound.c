@@ -16,15 +16,6 @@
 #include "mesh_scenes.h"
 
 
-static carom_world *make_world(double gz)
-{
-    carom_world_def wd = carom_world_def_default();
-    wd.gravity.z = gz;
-    carom_world *w = carom_world_create(&wd);
-    assert_non_null(w);
-    return w;
-}
-
 static carom_body_id add_compound(carom_world *w, const carom_compound_child *c, int n, carom_body_type type,
                                   carom_vec3 at)
 {
@@ -71,7 +62,7 @@ static void dumbbell(carom_compound_child c[3], double r, double L, double a, do
 static void test_two_spheres_on_a_rod(void **state)
 {
     (void)state;
-    carom_world *w = make_world(-9.81);
+    carom_world *w = world_default();
     const double r = 0.1, L = 0.5, a = 0.02, h = 0.4, rho = 7800;
     carom_compound_child c[3];
     dumbbell(c, r, L, a, h, rho, 0);
@@ -111,7 +102,7 @@ static void test_two_spheres_on_a_rod(void **state)
 static void test_l_of_boxes(void **state)
 {
     (void)state;
-    carom_world *w = make_world(-9.81);
+    carom_world *w = world_default();
     carom_compound_child c[2];
     c[0] = carom_compound_child_default(carom_shape_box(1.0, 0.1, 0.1));
     c[0].position.x = 1.0;
@@ -163,7 +154,7 @@ static void test_dumbbell_rolls_as_analytic(void **state)
     double thetas[2] = {0.15, 0.3};
     for (int k = 0; k < 2; k++) {
         double th = thetas[k];
-        carom_world *w = make_world(-9.81);
+        carom_world *w = world_default();
         carom_body_def pd = carom_body_def_default();
         pd.type = CAROM_BODY_STATIC;
         pd.shape = carom_shape_plane(sin(th), 0, cos(th), 0); /* descends along +x */
@@ -195,7 +186,7 @@ static void test_dumbbell_rolls_as_analytic(void **state)
 static void test_table_stands_on_mesh(void **state)
 {
     (void)state;
-    carom_world *w = make_world(-9.81);
+    carom_world *w = world_default();
     double *v; int *t; int nv, nt;
     scene_grid(10, 1.0, 0.0, 5u, &v, &nv, &t, &nt);
     carom_vec3 o = {0, 0, 0};
@@ -232,7 +223,7 @@ static void test_table_stands_on_mesh(void **state)
 static void test_child_in_ray_casts_and_events(void **state)
 {
     (void)state;
-    carom_world *w = make_world(-9.81);
+    carom_world *w = world_default();
     carom_body_def pd = carom_body_def_default();
     pd.type = CAROM_BODY_STATIC;
     pd.shape = carom_shape_plane(0, 0, 1, 0);
@@ -288,7 +279,7 @@ static void expect_refused(carom_world *w, const carom_compound_child *c, int n,
 static void test_bad_compounds_refused(void **state)
 {
     (void)state;
-    carom_world *w = make_world(-9.81);
+    carom_world *w = world_default();
     carom_compound_child c[2];
     c[0] = carom_compound_child_default(carom_shape_sphere(0.5));
     c[1] = carom_compound_child_default(carom_shape_box(0.5, 0.5, 0.5));

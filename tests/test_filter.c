@@ -12,18 +12,11 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
 typedef struct filter_bits { uint64_t category, mask; int group; } filter_bits;
 
-static carom_world *make_world(void)
-{
-    carom_world_def d = carom_world_def_default();
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
-}
-
-static carom_body_id add_ground(carom_world *w, filter_bits f)
+static carom_body_id add_filtered_ground(carom_world *w, filter_bits f)
 {
     carom_body_def d = carom_body_def_default();
     d.type = CAROM_BODY_STATIC;
@@ -32,10 +25,10 @@ static carom_body_id add_ground(carom_world *w, filter_bits f)
     d.category = f.category;
     d.mask = f.mask;
     d.group = f.group;
-    return carom_body_create(w, &d);
+    return add_body(w, &d);
 }
 
-static carom_body_id add_ball(carom_world *w, filter_bits f, double z)
+static carom_body_id add_filtered_ball(carom_world *w, filter_bits f, double z)
 {
     carom_body_def d = carom_body_def_default();
     d.shape = carom_shape_sphere(0.25);
@@ -43,14 +36,7 @@ static carom_body_id add_ball(carom_world *w, filter_bits f, double z)
     d.category = f.category;
     d.mask = f.mask;
     d.group = f.group;
-    return carom_body_create(w, &d);
-}
-
-static double height(carom_world *w, carom_body_id b)
-{
-    carom_vec3 p;
-    assert_int_equal(carom_body_get_position(w, b, &p), CAROM_OK);
-    return p.z;
+    return add_body(w, &d);
 }
 
 /* The rule, written out independently of the library. */
@@ -63,13 +49,13 @@ static int expected_collide(filter_bits a, filter_bits b)
 /* Drops a ball on the ground for 1 s: 1 when it rests on it, 0 when it fell through. */
 static int ball_lands(filter_bits ball, filter_bits ground, int ball_first)
 {
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_body_id b, g;
-    if (ball_first) { b = add_ball(w, ball, 0.5); g = add_ground(w, ground); }
-    else { g = add_ground(w, ground); b = add_ball(w, ball, 0.5); }
+    if (ball_first) { b = add_filtered_ball(w, ball, 0.5); g = add_filtered_ground(w, ground); }
+    else { g = add_filtered_ground(w, ground); b = add_filtered_ball(w, ball, 0.5); }
     assert_false(carom_body_id_is_null(b) || carom_body_id_is_null(g));
     for (int i = 0; i < 60; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
-    double z = height(w, b);
+    double z = pos(w, b).z;
     carom_world_destroy(w);
     if (fabs(z - 0.25) < 0.01) return 1;
     assert_true(z < -0.5); /* no half measures: through */
@@ -117,9 +103,9 @@ static int count_events(carom_world *w, carom_event_type type)
 static void test_runtime_change_on_sleeping_body(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     filter_bits all = {1, CAROM_MASK_ALL, 0};
-    carom_body_id g = add_ground(w, all), b = add_ball(w, all, 0.26);
+    carom_body_id g = add_filtered_ground(w, all), b = add_filtered_ball(w, all, 0.26);
     (void)g;
     for (int i = 0; i < 120; i++) carom_world_step(w, 1.0 / 60);
     assert_false(carom_body_is_awake(w, b));
@@ -132,11 +118,11 @@ static void test_runtime_change_on_sleeping_body(void **state)
     carom_world_step(w, 1.0 / 60);
     assert_int_equal(count_events(w, CAROM_EVENT_END), 1);
     for (int i = 0; i < 10; i++) carom_world_step(w, 1.0 / 60);
-    assert_true(height(w, b) < 0.2);
+    assert_true(pos(w, b).z < 0.2);
     /* allowed again while falling into the ground: pushed out and resting on it */
     assert_int_equal(carom_body_set_filter(w, b, 1, CAROM_MASK_ALL, 0), CAROM_OK);
     for (int i = 0; i < 120; i++) carom_world_step(w, 1.0 / 60);
-    assert_true(fabs(height(w, b) - 0.25) < 0.01);
+    assert_true(fabs(pos(w, b).z - 0.25) < 0.01);
     carom_world_destroy(w);
 }
 
@@ -164,17 +150,17 @@ static int reject_pair(void *ctx, carom_body_id a, carom_body_id b)
 static void test_pair_filter_callback(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     filter_bits all = {1, CAROM_MASK_ALL, 0};
-    add_ground(w, all);
-    carom_body_id kept = add_ball(w, all, 0.5), passed = add_ball(w, all, 0.5);
+    add_filtered_ground(w, all);
+    carom_body_id kept = add_filtered_ball(w, all, 0.5), passed = add_filtered_ball(w, all, 0.5);
     carom_vec3 p = {2, 0, 0.5};
     carom_body_set_position(w, passed, p);
     pair_log log = {w, 0, 0, passed};
     assert_int_equal(carom_world_set_pair_filter(w, reject_pair, &log), CAROM_OK);
     for (int i = 0; i < 60; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
-    assert_true(fabs(height(w, kept) - 0.25) < 0.01);
-    assert_true(height(w, passed) < -0.5);
+    assert_true(fabs(pos(w, kept).z - 0.25) < 0.01);
+    assert_true(pos(w, passed).z < -0.5);
     assert_true(log.calls >= 2);
     assert_int_equal(log.refused_destroy, log.calls); /* destroying from it is refused */
     assert_int_equal(carom_world_body_count(w), 3);
@@ -184,7 +170,7 @@ static void test_pair_filter_callback(void **state)
     carom_body_set_position(w, passed, up);
     carom_body_set_linear_velocity(w, passed, still);
     for (int i = 0; i < 60; i++) carom_world_step(w, 1.0 / 60);
-    assert_true(fabs(height(w, passed) - 0.25) < 0.01);
+    assert_true(fabs(pos(w, passed).z - 0.25) < 0.01);
     carom_world_destroy(w);
 }
 
@@ -220,15 +206,15 @@ static void test_continuous_collision_honours_bits(void **state)
 static void test_bad_input(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     filter_bits all = {1, CAROM_MASK_ALL, 0};
-    carom_body_id b = add_ball(w, all, 1);
+    carom_body_id b = add_filtered_ball(w, all, 1);
     carom_body_destroy(w, b);
     assert_int_equal(carom_body_set_filter(w, b, 1, 1, 0), CAROM_ERROR_STALE_ID);
     assert_non_null(strstr(carom_world_last_error(w), "destroyed"));
     uint64_t c;
     assert_int_equal(carom_body_get_filter(w, b, &c, NULL, NULL), CAROM_ERROR_STALE_ID);
-    carom_body_id b2 = add_ball(w, all, 1);
+    carom_body_id b2 = add_filtered_ball(w, all, 1);
     assert_int_equal(carom_body_get_filter(w, b2, NULL, NULL, NULL), CAROM_ERROR_INVALID_ARGUMENT);
     assert_int_equal(carom_body_set_filter(NULL, b2, 1, 1, 0), CAROM_ERROR_INVALID_ARGUMENT);
     assert_int_equal(carom_world_set_pair_filter(NULL, NULL, NULL), CAROM_ERROR_INVALID_ARGUMENT);

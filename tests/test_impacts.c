@@ -39,15 +39,12 @@ static carom_vec3 cross3(carom_vec3 a, carom_vec3 b)
 
 static carom_world *world_for(const char *preset, carom_vec3 gravity)
 {
-    carom_world_def wd = carom_world_def_default();
-    assert_int_equal(carom_world_def_apply_preset(&wd, preset), CAROM_OK);
+    carom_world_def wd = preset_def(preset);
     wd.gravity = gravity;
-    carom_world *w = carom_world_create(&wd);
-    assert_non_null(w);
-    return w;
+    return world_with(wd, 0, 0.0, 0.0);
 }
 
-static carom_body_id add_static(carom_world *w, carom_shape_def shape, carom_vec3 at, double mu, double e)
+static carom_body_id add_surface(carom_world *w, carom_shape_def shape, carom_vec3 at, double mu, double e)
 {
     carom_body_def d = carom_body_def_default();
     d.type = CAROM_BODY_STATIC;
@@ -55,9 +52,7 @@ static carom_body_id add_static(carom_world *w, carom_shape_def shape, carom_vec
     d.position = at;
     d.friction = mu;
     d.restitution = e;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
+    return add_body(w, &d);
 }
 
 static carom_body_id add_ball(carom_world *w, double r, double m, carom_vec3 at, carom_vec3 v, double mu, double e)
@@ -69,14 +64,7 @@ static carom_body_id add_ball(carom_world *w, double r, double m, carom_vec3 at,
     d.linear_velocity = v;
     d.friction = mu;
     d.restitution = e;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
-}
-
-static void run(carom_world *w, int steps, double dt)
-{
-    for (int i = 0; i < steps; i++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+    return add_body(w, &d);
 }
 
 static carom_vec3 velocity(carom_world *w, carom_body_id id)
@@ -113,10 +101,10 @@ static void oblique_case(const char *preset, double dt, double r, double m, doub
 {
     const double vt = 4.0, vn = 3.0;
     carom_world *w = world_for(preset, cv(0, 0, 0));
-    add_static(w, carom_shape_plane(0, 0, 1, origin.z), cv(0, 0, 0), mu, e);
+    add_surface(w, carom_shape_plane(0, 0, 1, origin.z), cv(0, 0, 0), mu, e);
     double gap = vn * dt * (3.0 + frac);
     carom_body_id ball = add_ball(w, r, m, cv(origin.x, origin.y, origin.z + r + gap), cv(vt, 0, -vn), mu, e);
-    run(w, 10, dt);
+    step_n(w, 10, dt);
     double jn = (1.0 + e) * m * vn;
     double jt = fmin(mu * jn, 2.0 / 7.0 * m * vt);
     double inertia = 0.4 * m * r * r;
@@ -164,7 +152,7 @@ static void pair_case(const char *preset, double dt, double r, double m1, double
     carom_body_id t = add_ball(w, r, m2, o, cv(0, 0, 0), 0.0, e);
     carom_vec3 P0, L0, P1, L1;
     assert_int_equal(carom_world_get_momentum(w, &P0, &L0), CAROM_OK);
-    run(w, 12, dt);
+    step_n(w, 12, dt);
     assert_int_equal(carom_world_get_momentum(w, &P1, &L1), CAROM_OK);
     carom_vec3 vt = velocity(w, t);
     double got = atan2(-vt.y, vt.x) * 180.0 / PI_;
@@ -206,10 +194,10 @@ static void test_off_centre_pair(void **state)
 static void reflection_case(const char *preset, double dt, double u, double frac)
 {
     carom_world *w = world_for(preset, cv(0, 0, 0));
-    add_static(w, carom_shape_box(5, 5, 0.5), cv(0, 0, -0.5), 0.0, 1.0);
+    add_surface(w, carom_shape_box(5, 5, 0.5), cv(0, 0, -0.5), 0.0, 1.0);
     /* one free step first, then the step of the impact */
     carom_body_id ball = add_ball(w, 1.0, 1.0, cv(0, 0, 1.0 + u * dt * (1.0 + frac)), cv(0, 0, -u), 0.0, 1.0);
-    run(w, 2, dt);
+    step_n(w, 2, dt);
     double want = 1.0 + (1.0 - frac) * u * dt;
     double z = position(w, ball).z;
     print_message("%s dt 1/%.0f %g m/s at %.2f of the step: z %.4f (exact %.4f)\n", preset, 1 / dt, u, frac, z, want);
@@ -237,13 +225,13 @@ static void test_reflection_keeps_rest_of_step(void **state)
 static void cradle_case(const char *preset, double r, double speed, double gap, int floor)
 {
     carom_world *w = world_for(preset, floor ? cv(0, 0, -G) : cv(0, 0, 0));
-    if (floor) add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.0);
+    if (floor) add_surface(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.0);
     carom_body_id ball[5];
     double z = floor ? r : 0.0;
     ball[0] = add_ball(w, r, 1.0, cv(-gap, 0, z), cv(speed, 0, 0), 0.0, 1.0);
     for (int i = 1; i < 5; i++) ball[i] = add_ball(w, r, 1.0, cv(2.0 * r * i, 0, z), cv(0, 0, 0), 0.0, 1.0);
-    if (floor) run(w, 1, 1.0 / 60); /* the resting contacts exist before the impact */
-    run(w, 60, 1.0 / 60);
+    if (floor) step_n(w, 1, 1.0 / 60); /* the resting contacts exist before the impact */
+    step_n(w, 60, 1.0 / 60);
     print_message("%s cradle r %g at %g m/s, gap %g%s:", preset, r, speed, gap, floor ? ", on a floor" : "");
     for (int i = 0; i < 5; i++) print_message(" %.4f", velocity(w, ball[i]).x / speed);
     print_message("\n");
@@ -278,7 +266,7 @@ static void break_case(const char *preset, double dt)
     carom_vec3 P0, L0, P1, L1;
     carom_world_get_energy(w, &e0, &pe);
     carom_world_get_momentum(w, &P0, &L0);
-    run(w, (int)(1.0 / dt), dt);
+    step_n(w, (int)(1.0 / dt), dt);
     carom_world_get_energy(w, &e1, &pe);
     carom_world_get_momentum(w, &P1, &L1);
     print_message("%s dt 1/%.0f break: energy kept %.5f, momentum error %.2e\n", preset, 1 / dt, e1 / e0,
@@ -307,7 +295,7 @@ static void test_elastic_gas_default_settings(void **state)
     const double L = 3.0;
     const double walls[6][3] = {{0, 0, 1}, {0, 0, -1}, {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
     for (int i = 0; i < 6; i++)
-        add_static(w, carom_shape_plane(walls[i][0], walls[i][1], walls[i][2], -L), cv(0, 0, 0), 0.0, 1.0);
+        add_surface(w, carom_shape_plane(walls[i][0], walls[i][1], walls[i][2], -L), cv(0, 0, 0), 0.0, 1.0);
     uint32_t rng = 11u;
     for (int i = 0; i < 5; i++)
         for (int j = 0; j < 5; j++)
@@ -322,7 +310,7 @@ static void test_elastic_gas_default_settings(void **state)
             }
     double e0, e1, pe;
     carom_world_get_energy(w, &e0, &pe);
-    run(w, 600, 1.0 / 60);
+    step_n(w, 600, 1.0 / 60);
     carom_world_get_energy(w, &e1, &pe);
     print_message("elastic gas, default settings: energy kept %.5f over 10 s\n", e1 / e0);
     assert_true(fabs(e1 / e0 - 1.0) <= 0.01);
@@ -337,7 +325,7 @@ static void test_elastic_gas_default_settings(void **state)
 static double force_bounce_apex(const char *preset, int by_force, double h, double dt)
 {
     carom_world *w = world_for(preset, by_force ? cv(0, 0, 0) : cv(0, 0, -G));
-    add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 1.0);
+    add_surface(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 1.0);
     const double r = 0.1, m = 2.0;
     carom_body_id ball = add_ball(w, r, m, cv(0, 0, h + r), cv(0, 0, 0), 0.0, 1.0);
     int bounced = 0;
@@ -380,7 +368,7 @@ static void test_force_driven_bounce(void **state)
 static double drop_apex(const char *preset, double dt, double h, double r)
 {
     carom_world *w = world_for(preset, cv(0, 0, -G));
-    add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.5);
+    add_surface(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.5);
     carom_body_id ball = add_ball(w, r, 1.0, cv(0, 0, h + r), cv(0, 0, 0), 0.0, 0.5);
     int bounced = 0;
     double apex = 0.0;
@@ -428,8 +416,8 @@ static void test_flat_landings_every_shape(void **state)
         for (int k = 0; k < 4; k++)
             for (int p = 0; p < 3; p++) {
                 carom_world *w = world_for(PRESETS[p], cv(0, 0, 0));
-                if (ground == 0) add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.5);
-                else add_static(w, carom_shape_box(3, 3, 0.5), cv(0, 0, -0.5), 0.0, 0.5);
+                if (ground == 0) add_surface(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.0, 0.5);
+                else add_surface(w, carom_shape_box(3, 3, 0.5), cv(0, 0, -0.5), 0.0, 0.5);
                 carom_body_def d = carom_body_def_default();
                 d.shape = shapes[k];
                 d.mass = 2.0;
@@ -442,7 +430,7 @@ static void test_flat_landings_every_shape(void **state)
                 d.linear_velocity = cv(0, 0, -2.0);
                 carom_body_id id = carom_body_create(w, &d);
                 assert_false(carom_body_id_is_null(id));
-                run(w, 10, 1.0 / 60);
+                step_n(w, 10, 1.0 / 60);
                 carom_vec3 v = velocity(w, id), av = spin(w, id);
                 print_message("%s shape %d on %s: v (%.5f %.5f %.5f), |w| %.2e\n", PRESETS[p], k,
                               ground ? "a box" : "a plane", v.x, v.y, v.z, len3(av));
@@ -466,7 +454,7 @@ static int hits_for(double hit_threshold, double restitution_threshold, double *
     wd.restitution_threshold = restitution_threshold;
     carom_world *w = carom_world_create(&wd);
     assert_non_null(w);
-    add_static(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.5, 0.0);
+    add_surface(w, carom_shape_plane(0, 0, 1, 0), cv(0, 0, 0), 0.5, 0.0);
     add_ball(w, 0.1, 1.0, cv(0, 0, 0.2), cv(0, 0, 0), 0.5, 0.0);
     int hits = 0;
     for (int i = 0; i < 60; i++) {

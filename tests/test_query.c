@@ -59,24 +59,14 @@ static carom_shape_def make_def(int type, double k)
     }
 }
 
-static carom_world *make_world(void)
-{
-    carom_world_def d = carom_world_def_default();
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
-}
-
-static carom_body_id add_body(carom_world *w, carom_shape_def sd, carom_vec3 p, carom_quat q, carom_body_type type)
+static carom_body_id add_posed(carom_world *w, carom_shape_def sd, carom_vec3 p, carom_quat q, carom_body_type type)
 {
     carom_body_def d = carom_body_def_default();
     d.shape = sd;
     d.position = p;
     d.orientation = q;
     d.type = type;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
+    return add_body(w, &d);
 }
 
 static const shape *body_shape(const carom_world *w, carom_body_id id)
@@ -209,14 +199,14 @@ static void test_distance_against_sampling(void **state)
     for (int ta = 0; ta < N_CONVEX; ta++)
         for (int tb = 0; tb < N_CONVEX; tb++)
             for (int rep = 0; rep < 3; rep++) {
-                carom_world *w = make_world();
+                carom_world *w = world_default();
                 double far = rep == 2 ? 1e5 : 0.0; /* the same geometry far from the origin */
                 carom_vec3 pa = {far + srand1(), srand1(), srand1()};
                 vec3 dir = v3_normalize(v3(srand1(), srand1(), srand1()));
                 double gap = 1.2 + 1.5 * urand();
                 carom_vec3 pb = cv(v3_madd(tv(pa), gap, dir));
-                carom_body_id a = add_body(w, make_def(ta, 0.7 + 0.6 * urand()), pa, random_quat(), CAROM_BODY_DYNAMIC);
-                carom_body_id b = add_body(w, make_def(tb, 0.7 + 0.6 * urand()), pb, random_quat(), CAROM_BODY_DYNAMIC);
+                carom_body_id a = add_posed(w, make_def(ta, 0.7 + 0.6 * urand()), pa, random_quat(), CAROM_BODY_DYNAMIC);
+                carom_body_id b = add_posed(w, make_def(tb, 0.7 + 0.6 * urand()), pb, random_quat(), CAROM_BODY_DYNAMIC);
                 carom_distance_result r;
                 assert_int_equal(carom_world_body_distance(w, a, b, &r), CAROM_OK);
                 sample_surface(body_shape(w, a), body_pose(w, a), h, &sa);
@@ -254,10 +244,10 @@ static void test_overlap_against_sampling(void **state)
     for (int ta = 0; ta < N_CONVEX; ta++)
         for (int tb = 0; tb < N_CONVEX; tb++)
             for (int rep = 0; rep < 8; rep++) {
-                carom_world *w = make_world();
+                carom_world *w = world_default();
                 double k = 0.7 + 0.6 * urand();
                 carom_vec3 pb = {srand1() * 0.2, srand1() * 0.2, srand1() * 0.2};
-                carom_body_id b = add_body(w, make_def(tb, k), pb, random_quat(), CAROM_BODY_STATIC);
+                carom_body_id b = add_posed(w, make_def(tb, k), pb, random_quat(), CAROM_BODY_STATIC);
                 vec3 dir = v3_normalize(v3(srand1(), srand1(), srand1()));
                 carom_vec3 pa = cv(v3_madd(tv(pb), 0.3 + 1.0 * urand(), dir));
                 carom_quat qa = random_quat();
@@ -266,7 +256,7 @@ static void test_overlap_against_sampling(void **state)
                 int n = carom_world_overlap(w, &da, pa, qa, NULL, ids, 4);
                 assert_true(n == 0 || n == 1);
                 /* the same shape as a body, for the brute force */
-                carom_body_id a = add_body(w, da, pa, qa, CAROM_BODY_STATIC);
+                carom_body_id a = add_posed(w, da, pa, qa, CAROM_BODY_STATIC);
                 sample_surface(body_shape(w, a), body_pose(w, a), h, &sa);
                 sample_surface(body_shape(w, b), body_pose(w, b), h, &sb);
                 int inside = 0;
@@ -293,13 +283,13 @@ static void test_plane_distance_and_overlap(void **state)
 {
     (void)state;
     for (int t = 0; t < N_CONVEX; t++) {
-        carom_world *w = make_world();
+        carom_world *w = world_default();
         carom_quat id = {1, 0, 0, 0};
         carom_vec3 o = {0, 0, 0};
-        carom_body_id ground = add_body(w, carom_shape_plane(0, 0, 1, 0.25), o, id, CAROM_BODY_STATIC);
+        carom_body_id ground = add_posed(w, carom_shape_plane(0, 0, 1, 0.25), o, id, CAROM_BODY_STATIC);
         carom_quat q = random_quat();
         carom_vec3 p = {srand1(), srand1(), 2.0};
-        carom_body_id b = add_body(w, make_def(t, 1.0), p, q, CAROM_BODY_DYNAMIC);
+        carom_body_id b = add_posed(w, make_def(t, 1.0), p, q, CAROM_BODY_DYNAMIC);
         /* lowest point from the support mapping, independent of the query */
         const shape *sh = body_shape(w, b);
         xform x = body_pose(w, b);
@@ -325,18 +315,18 @@ static void test_plane_distance_and_overlap(void **state)
 static void test_overlapping_bodies_distance_is_penetration(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_quat id = {1, 0, 0, 0};
     carom_vec3 pa = {0, 0, 0}, pb = {0.9, 0, 0};
-    carom_body_id a = add_body(w, carom_shape_sphere(0.5), pa, id, CAROM_BODY_DYNAMIC);
-    carom_body_id b = add_body(w, carom_shape_sphere(0.5), pb, id, CAROM_BODY_DYNAMIC);
+    carom_body_id a = add_posed(w, carom_shape_sphere(0.5), pa, id, CAROM_BODY_DYNAMIC);
+    carom_body_id b = add_posed(w, carom_shape_sphere(0.5), pb, id, CAROM_BODY_DYNAMIC);
     carom_distance_result r;
     assert_int_equal(carom_world_body_distance(w, a, b, &r), CAROM_OK);
     assert_true(fabs(r.distance + 0.1) < 1e-12);
     assert_true(fabs(r.normal.x - 1) < 1e-12);
     /* the nearest body to a shape: the closest of several, within max_distance */
     carom_vec3 pc = {5, 0, 0};
-    add_body(w, carom_shape_box(0.5, 0.5, 0.5), pc, id, CAROM_BODY_STATIC);
+    add_posed(w, carom_shape_box(0.5, 0.5, 0.5), pc, id, CAROM_BODY_STATIC);
     carom_shape_def probe = carom_shape_sphere(0.25);
     carom_vec3 at = {3.0, 0, 0};
     assert_int_equal(carom_world_shape_distance(w, &probe, at, id, 10.0, NULL, &r), 1);
@@ -385,12 +375,12 @@ static void test_shape_cast_against_sweep(void **state)
     for (int ta = 0; ta < N_CONVEX; ta++)
         for (int tb = 0; tb <= N_CONVEX; tb++)
             for (int rep = 0; rep < 6; rep++) {
-                carom_world *w = make_world();
+                carom_world *w = world_default();
                 carom_quat id = {1, 0, 0, 0};
                 carom_vec3 pb = {0, 0, 0};
                 carom_body_id b = tb == N_CONVEX
-                                      ? add_body(w, carom_shape_plane(0, 0, 1, -0.8), pb, id, CAROM_BODY_STATIC)
-                                      : add_body(w, make_def(tb, 0.8 + 0.4 * urand()), pb, random_quat(), CAROM_BODY_STATIC);
+                                      ? add_posed(w, carom_shape_plane(0, 0, 1, -0.8), pb, id, CAROM_BODY_STATIC)
+                                      : add_posed(w, make_def(tb, 0.8 + 0.4 * urand()), pb, random_quat(), CAROM_BODY_STATIC);
                 carom_shape_def da = make_def(ta, 0.8 + 0.4 * urand());
                 carom_quat qa = random_quat();
                 vec3 dir = v3_normalize(v3(srand1(), srand1(), 0.5 + urand()));
@@ -401,7 +391,7 @@ static void test_shape_cast_against_sweep(void **state)
                 carom_ray_hit hit;
                 int r = carom_world_shape_cast(w, &da, cv(start), qa, cv(T), NULL, &hit);
                 assert_true(r == 0 || r == 1);
-                carom_body_id a = add_body(w, da, cv(start), qa, CAROM_BODY_STATIC);
+                carom_body_id a = add_posed(w, da, cv(start), qa, CAROM_BODY_STATIC);
                 const shape *sha = body_shape(w, a), *shb = body_shape(w, b);
                 xform xa = body_pose(w, a), xb = body_pose(w, b);
                 assert_false(narrowphase_overlap(sha, xa, shb, xb));
@@ -503,10 +493,10 @@ static void test_shape_cast_against_sweep(void **state)
 static void test_shape_cast_initial_overlap_and_far(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_quat id = {1, 0, 0, 0};
     carom_vec3 o = {1e6, -1e6, 1e6};
-    carom_body_id box = add_body(w, carom_shape_box(1, 1, 1), o, id, CAROM_BODY_STATIC);
+    carom_body_id box = add_posed(w, carom_shape_box(1, 1, 1), o, id, CAROM_BODY_STATIC);
     carom_shape_def s = carom_shape_sphere(0.5);
     carom_ray_hit hit;
     /* overlapping at the start: fraction 0, normal against the sweep */
@@ -530,11 +520,11 @@ static void test_ray_inside_convention(void **state)
 {
     (void)state;
     for (int t = 0; t <= N_CONVEX; t++) {
-        carom_world *w = make_world();
+        carom_world *w = world_default();
         carom_vec3 p = {2, -1, 0.5};
         carom_quat q = random_quat(), level = {1, 0, 0, 0};
-        carom_body_id b = t == N_CONVEX ? add_body(w, carom_shape_plane(0, 0, 1, 0), p, level, CAROM_BODY_STATIC)
-                                        : add_body(w, make_def(t, 1.0), p, q, CAROM_BODY_STATIC);
+        carom_body_id b = t == N_CONVEX ? add_posed(w, carom_shape_plane(0, 0, 1, 0), p, level, CAROM_BODY_STATIC)
+                                        : add_posed(w, make_def(t, 1.0), p, q, CAROM_BODY_STATIC);
         carom_vec3 origin = {p.x + 0.05, p.y - 0.03, p.z - 0.02}, tr = {0, 3, 4};
         carom_ray_hit hit;
         assert_int_equal(carom_world_ray_cast(w, origin, tr, &hit), 1);
@@ -559,12 +549,12 @@ static void test_ray_precision_far_away(void **state)
     for (double d = 1e2; d <= 1e6 * 1.01; d *= 10)
         for (int t = 0; t <= N_CONVEX; t++)
             for (int moved = 0; moved < 2; moved++) {
-                carom_world *w = make_world();
+                carom_world *w = world_default();
                 carom_quat id = {1, 0, 0, 0};
                 carom_vec3 p = {moved ? d : 0, moved ? -d : 0, moved ? d : 0};
                 carom_shape_def sd = t == N_CONVEX ? carom_shape_plane(1, 0, 0, 0) : make_def(t, 1.0);
                 if (t == 4) sd = make_def(1, 1.0); /* a hull's faces: see below */
-                add_body(w, sd, p, id, CAROM_BODY_STATIC);
+                add_posed(w, sd, p, id, CAROM_BODY_STATIC);
                 /* expected surface point along +x: radius, half extent, ... */
                 double surface = t == 0 ? 0.5 : t == 1 || t == 4 ? 0.4 : t == 2 ? 0.3 : t == 3 ? 0.45 : 0.0;
                 double start = moved ? 50.0 : d;
@@ -588,11 +578,11 @@ static void test_ray_precision_hull(void **state)
 {
     (void)state;
     for (double d = 1e2; d <= 1e6 * 1.01; d *= 10) {
-        carom_world *w = make_world();
+        carom_world *w = world_default();
         carom_quat id = {1, 0, 0, 0};
         carom_vec3 p = {0, 0, 0};
         carom_shape_def sd = make_def(4, 1.0);
-        carom_body_id b = add_body(w, sd, p, id, CAROM_BODY_STATIC);
+        carom_body_id b = add_posed(w, sd, p, id, CAROM_BODY_STATIC);
         vec3 dir = v3_normalize(v3(1, 0.3, 0.2));
         carom_vec3 origin = cv(v3_scale(dir, d)), tr = cv(v3_scale(dir, -2 * d));
         carom_ray_hit hit;
@@ -616,7 +606,7 @@ static int reject_second(void *ctx, carom_body_id id)
 static void test_ray_cast_all_and_filters(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_quat id = {1, 0, 0, 0};
     carom_body_id row[5];
     for (int i = 0; i < 5; i++) {
@@ -679,12 +669,12 @@ static int destroying_filter(void *ctx, carom_body_id id)
 static void test_bad_input_leaves_world_unchanged(void **state)
 {
     (void)state;
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_quat id = {1, 0, 0, 0}, bad_q = {2, 0, 0, 0};
     carom_vec3 o = {0, 0, 0}, nan3 = {NAN, 0, 0}, t = {0, 0, -1};
-    carom_body_id a = add_body(w, carom_shape_sphere(0.5), o, id, CAROM_BODY_DYNAMIC);
+    carom_body_id a = add_posed(w, carom_shape_sphere(0.5), o, id, CAROM_BODY_DYNAMIC);
     carom_vec3 po = {3, 0, 0};
-    carom_body_id b = add_body(w, carom_shape_box(0.5, 0.5, 0.5), po, id, CAROM_BODY_DYNAMIC);
+    carom_body_id b = add_posed(w, carom_shape_box(0.5, 0.5, 0.5), po, id, CAROM_BODY_DYNAMIC);
     carom_shape_def s = carom_shape_sphere(0.5), bad_s = carom_shape_sphere(-1), plane = carom_shape_plane(0, 0, 1, 0);
     carom_ray_hit hit;
     carom_body_id ids[4];
@@ -710,7 +700,7 @@ static void test_bad_input_leaves_world_unchanged(void **state)
     assert_int_equal(carom_world_shape_distance(w, &s, o, id, NAN, NULL, &r), -1);
     assert_int_equal(carom_world_body_distance(w, a, a, &r), CAROM_ERROR_INVALID_ARGUMENT);
     assert_int_equal(carom_world_body_distance(w, a, b, NULL), CAROM_ERROR_INVALID_ARGUMENT);
-    carom_body_id gone = add_body(w, carom_shape_sphere(0.5), po, id, CAROM_BODY_DYNAMIC);
+    carom_body_id gone = add_posed(w, carom_shape_sphere(0.5), po, id, CAROM_BODY_DYNAMIC);
     carom_body_destroy(w, gone);
     assert_int_equal(carom_world_body_distance(w, a, gone, &r), CAROM_ERROR_STALE_ID);
     assert_non_null(strstr(carom_world_last_error(w), "body b"));
@@ -749,7 +739,7 @@ static void test_queries_against_a_mesh(void **state)
             tris[nt++] = a; tris[nt++] = b; tris[nt++] = c;
             tris[nt++] = a; tris[nt++] = c; tris[nt++] = d;
         }
-    carom_world *w = make_world();
+    carom_world *w = world_default();
     carom_mesh_def md = carom_mesh_def_default();
     md.vertices = verts; md.vertex_count = 25; md.triangles = tris; md.triangle_count = nt / 3;
     carom_body_def bd = carom_body_def_default();
@@ -768,7 +758,7 @@ static void test_queries_against_a_mesh(void **state)
         assert_int_equal(carom_world_shape_cast(w, &sd, from, q, down, NULL, &hit), 1);
         assert_true(carom_body_id_equal(hit.body, ground));
         /* the lowest point along -z from the support mapping lands on z = 0.3 */
-        carom_body_id probe = add_body(w, sd, from, q, CAROM_BODY_STATIC);
+        carom_body_id probe = add_posed(w, sd, from, q, CAROM_BODY_STATIC);
         const shape *sh = body_shape(w, probe);
         xform x = body_pose(w, probe);
         double low = xf_point(x, shape_support_local(sh, q_inv_rotate(x.q, v3(0, 0, -1)))).z;
@@ -793,7 +783,7 @@ static void test_queries_against_a_mesh(void **state)
     assert_true(fabs(hit.point.z - 0.3) < 1e-12);
     /* a body against the mesh */
     carom_vec3 pb = {100, 0, 2};
-    carom_body_id ball = add_body(w, carom_shape_sphere(0.5), pb, id, CAROM_BODY_DYNAMIC);
+    carom_body_id ball = add_posed(w, carom_shape_sphere(0.5), pb, id, CAROM_BODY_DYNAMIC);
     carom_distance_result r;
     assert_int_equal(carom_world_body_distance(w, ball, ground, &r), CAROM_OK);
     assert_true(fabs(r.distance - 1.2) < 1e-9 && fabs(r.normal.z + 1) < 1e-9);

@@ -14,14 +14,6 @@
 #include "helpers.h"
 #include "world.h"
 
-static carom_body_id add_sphere(carom_world *w, double x, double y, double z)
-{
-    carom_body_def d = carom_body_def_default();
-    d.position.x = x; d.position.y = y; d.position.z = z;
-    d.shape = carom_shape_sphere(0.5);
-    return carom_body_create(w, &d);
-}
-
 static void test_version_and_status(void **state)
 {
     (void)state;
@@ -37,13 +29,13 @@ static void test_id_generations(void **state)
 {
     (void)state;
     carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
-    carom_body_id a = add_sphere(w, 0, 0, 1);
+    carom_body_id a = add_sphere(w, 0, 0, 1, 0.5);
     assert_false(carom_body_id_is_null(a));
     assert_true(carom_body_is_valid(w, a));
     assert_int_equal(carom_body_destroy(w, a), CAROM_OK);
     assert_false(carom_body_is_valid(w, a));
     /* the slot is reused with a new generation: the old id stays invalid */
-    carom_body_id b = add_sphere(w, 1, 0, 1);
+    carom_body_id b = add_sphere(w, 1, 0, 1, 0.5);
     assert_int_equal(b.index1, a.index1);
     assert_int_not_equal(b.generation, a.generation);
     assert_false(carom_body_is_valid(w, a));
@@ -87,7 +79,7 @@ static void test_store_stays_dense(void **state)
             live--;
         } else {
             xs[created] = (double)op;
-            ids[created] = add_sphere(w, xs[created], 0, 0);
+            ids[created] = add_sphere(w, xs[created], 0, 0, 0.5);
             assert_false(carom_body_id_is_null(ids[created]));
             alive[created++] = 1;
             live++;
@@ -227,15 +219,15 @@ static void test_rejections_leave_world_unchanged(void **state)
     (void)state;
     carom_world *w = world_with(carom_world_def_default(), 0, 0.0, 0.0);
     carom_body_id ids[3];
-    ids[0] = add_sphere(w, 0, 0, 1);
-    ids[1] = add_sphere(w, 2, 0, 1);
+    ids[0] = add_sphere(w, 0, 0, 1, 0.5);
+    ids[1] = add_sphere(w, 2, 0, 1, 0.5);
     {
         carom_body_def d = carom_body_def_default();
         d.type = CAROM_BODY_STATIC;
         d.shape = carom_shape_box(5, 5, 0.5);
         ids[2] = carom_body_create(w, &d);
     }
-    carom_body_id stale = add_sphere(w, 9, 9, 9);
+    carom_body_id stale = add_sphere(w, 9, 9, 9, 0.5);
     carom_body_destroy(w, stale);
     snapshot s0;
     take(w, ids, 3, &s0);
@@ -421,7 +413,7 @@ static void test_mutation_inside_callback(void **state)
     g.type = CAROM_BODY_STATIC;
     g.shape = carom_shape_plane(0, 0, 1, 0);
     carom_body_create(w, &g);
-    carom_body_id ball = add_sphere(w, 0, 0, 0.6);
+    carom_body_id ball = add_sphere(w, 0, 0, 0.6, 0.5);
     probe.victim = ball;
     for (int i = 0; i < 30 && probe.calls == 0; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
     assert_true(probe.calls > 0);
