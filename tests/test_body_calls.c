@@ -12,24 +12,16 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
-static carom_world *zero_g(void)
-{
-    carom_world_def d = carom_world_def_default();
-    d.gravity.z = 0;
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
-}
-
-static carom_body_id add_box(carom_world *w, double hx, double hy, double hz, double mass, carom_quat q)
+static carom_body_id add_oriented_box(carom_world *w, double hx, double hy, double hz, double mass, carom_quat q)
 {
     carom_body_def d = carom_body_def_default();
     d.shape = carom_shape_box(hx, hy, hz);
     d.mass = mass;
     d.orientation = q;
     d.enable_sleep = 0;
-    return carom_body_create(w, &d);
+    return add_body(w, &d);
 }
 
 /* A box's principal moments m (b^2 + c^2) / 3 with half extents: the
@@ -37,12 +29,12 @@ static carom_body_id add_box(carom_world *w, double hx, double hy, double hz, do
 static void test_angular_impulse(void **state)
 {
     (void)state;
-    carom_world *w = zero_g();
+    carom_world *w = world_no_gravity();
     double hx = 0.5, hy = 0.25, hz = 0.1, m = 3.0;
     double I[3] = {m * (hy * hy + hz * hz) / 3, m * (hx * hx + hz * hz) / 3, m * (hx * hx + hy * hy) / 3};
     double c = cos(0.35), s = sin(0.35);
     carom_quat q = {c, 0, 0, s}; /* 0.7 rad about z */
-    carom_body_id b = add_box(w, hx, hy, hz, m, q);
+    carom_body_id b = add_oriented_box(w, hx, hy, hz, m, q);
     /* along the body's x axis, in world terms */
     double ca = cos(0.7), sa = sin(0.7);
     carom_vec3 L = {2.0 * ca, 2.0 * sa, 0};
@@ -78,9 +70,9 @@ static void test_damping_after_creation(void **state)
     (void)state;
     const double dts[] = {1.0 / 15, 1.0 / 60, 1.0 / 1000};
     for (int k = 0; k < 3; k++) {
-        carom_world *w = zero_g();
+        carom_world *w = world_no_gravity();
         carom_quat id = {1, 0, 0, 0};
-        carom_body_id b = add_box(w, 0.5, 0.5, 0.5, 1.0, id);
+        carom_body_id b = add_oriented_box(w, 0.5, 0.5, 0.5, 1.0, id);
         carom_vec3 v = {2, 0, 0}, av = {0, 0, 3};
         carom_body_set_linear_velocity(w, b, v);
         carom_body_set_angular_velocity(w, b, av);
@@ -111,7 +103,7 @@ static void test_damping_after_creation(void **state)
 static void test_frame_conversions(void **state)
 {
     (void)state;
-    carom_world *w = zero_g();
+    carom_world *w = world_no_gravity();
     double h = sqrt(0.5);
     carom_body_def d = carom_body_def_default();
     d.position.x = 1e6; d.position.y = 2; d.position.z = 3;
@@ -141,7 +133,7 @@ static void test_shape_round_trip(void **state)
     static const double pts[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.2, 0.2, 0.2};
     carom_shape_def defs[] = {carom_shape_sphere(0.3), carom_shape_box(0.1, 0.2, 0.3), carom_shape_capsule(0.2, 0.5),
                               carom_shape_cylinder(0.4, 0.1), carom_shape_hull(pts, 5), carom_shape_plane(0, 0, 2, 1)};
-    carom_world *w = zero_g();
+    carom_world *w = world_no_gravity();
     for (int i = 0; i < 6; i++) {
         carom_body_def d = carom_body_def_default();
         d.shape = defs[i];

@@ -13,26 +13,14 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
-
-#define PI_ 3.14159265358979323846
+#include "helpers.h"
 
 static const char *const presets[] = {"fast", "default", "accurate"};
 
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
 static carom_quat about_x(double angle)
 {
     carom_quat q = {cos(0.5 * angle), sin(0.5 * angle), 0, 0};
     return q;
-}
-
-static carom_world *world_preset(const char *preset, int gravity)
-{
-    carom_world_def d = carom_world_def_default();
-    assert_int_equal(carom_world_def_apply_preset(&d, preset), CAROM_OK);
-    if (!gravity) d.gravity = vec(0, 0, 0);
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
 }
 
 static double speculative_distance(const carom_world *w)
@@ -42,16 +30,7 @@ static double speculative_distance(const carom_world *w)
     return d.speculative_distance;
 }
 
-static void add_static(carom_world *w, carom_shape_def shape, carom_vec3 p)
-{
-    carom_body_def g = carom_body_def_default();
-    g.type = CAROM_BODY_STATIC;
-    g.shape = shape;
-    g.position = p;
-    assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
-}
-
-static carom_body_id add_body(carom_world *w, carom_shape_def shape, carom_vec3 p, carom_quat q, carom_vec3 v, carom_vec3 av)
+static carom_body_id add_moving(carom_world *w, carom_shape_def shape, carom_vec3 p, carom_quat q, carom_vec3 v, carom_vec3 av)
 {
     carom_body_def d = carom_body_def_default();
     d.shape = shape;
@@ -60,16 +39,7 @@ static carom_body_id add_body(carom_world *w, carom_shape_def shape, carom_vec3 
     d.linear_velocity = v;
     d.angular_velocity = av;
     d.mass = 1.0;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
-}
-
-static carom_vec3 pos(carom_world *w, carom_body_id id)
-{
-    carom_vec3 p;
-    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
-    return p;
+    return add_body(w, &d);
 }
 
 /* Steps n times; returns the deepest overlap seen after any step. */
@@ -100,7 +70,7 @@ static void test_thin_turning_bodies_stop_at_the_surface(void **state)
                 /* floor */
                 carom_world *w = world_preset(presets[p], 1);
                 add_static(w, carom_shape_box(50, 50, 0.5), vec(x0, 0, -0.5));
-                carom_body_id plate = add_body(w, carom_shape_box(0.5, 0.5, 0.005), vec(x0, 0, 3), about_x(PI_ / 6),
+                carom_body_id plate = add_moving(w, carom_shape_box(0.5, 0.5, 0.005), vec(x0, 0, 3), about_x(PI_ / 6),
                                                vec(0, 0, -speeds[k]), vec(0, 0, 0));
                 double deepest = run_deepest(w, 60, 1.0 / 60);
                 print_message("%s x0 %g plate at %g m/s onto the floor: deepest %.5f m, z %.4f\n", presets[p], x0,
@@ -111,7 +81,7 @@ static void test_thin_turning_bodies_stop_at_the_surface(void **state)
                 /* 5 cm wall, plate flying sideways */
                 w = world_preset(presets[p], 0);
                 add_static(w, carom_shape_box(0.025, 5, 5), vec(x0 + 5, 0, 0));
-                plate = add_body(w, carom_shape_box(0.005, 0.5, 0.5), vec(x0, 0, 0), about_x(PI_ / 6),
+                plate = add_moving(w, carom_shape_box(0.005, 0.5, 0.5), vec(x0, 0, 0), about_x(PI_ / 6),
                                  vec(speeds[k], 0, 0), vec(0, 0, 0));
                 deepest = run_deepest(w, 30, 1.0 / 60);
                 print_message("%s x0 %g plate at %g m/s into the wall: deepest %.5f m, x %.4f\n", presets[p], x0,
@@ -122,7 +92,7 @@ static void test_thin_turning_bodies_stop_at_the_surface(void **state)
             }
             carom_world *w = world_preset(presets[p], 1);
             add_static(w, carom_shape_plane(0, 0, 1, 0), vec(x0, 0, 0));
-            carom_body_id tile = add_body(w, carom_shape_box(0.25, 0.25, 0.005), vec(x0, 0, 5), about_x(0.3),
+            carom_body_id tile = add_moving(w, carom_shape_box(0.25, 0.25, 0.005), vec(x0, 0, 5), about_x(0.3),
                                           vec(0, 0, -500), vec(100, 0, 0));
             double deepest = run_deepest(w, 60, 1.0 / 60);
             print_message("%s x0 %g spinning tile at 500 m/s: deepest %.5f m, z %.4f\n", presets[p], x0, deepest,
@@ -149,7 +119,7 @@ static void test_spinning_rod_stays_above_the_floor(void **state)
                 carom_quat q = kind ? about_x(0) : about_x(PI_ / 2); /* both along y */
                 carom_world *w = world_preset(presets[p], 1);
                 add_static(w, carom_shape_plane(0, 0, 1, 0), vec(0, 0, 0));
-                add_body(w, rod, vec(0, 0, 0.03), q, vec(0, 0, 0), vec(500, 0, 0));
+                add_moving(w, rod, vec(0, 0, 0.03), q, vec(0, 0, 0), vec(500, 0, 0));
                 double deepest = run_deepest(w, (int)(rates[r] / 2), 1.0 / rates[r]);
                 print_message("%s dt 1/%g %s end over end: deepest %.5f\n", presets[p], rates[r],
                               kind ? "box" : "capsule", deepest);
@@ -158,7 +128,7 @@ static void test_spinning_rod_stays_above_the_floor(void **state)
             }
     for (int p = 0; p < 3; p++) {
         carom_world *w = world_preset(presets[p], 1);
-        carom_body_id id = add_body(w, carom_shape_capsule(0.02, 0.5), vec(0, 0, 10), about_x(PI_ / 2), vec(0, 0, 0),
+        carom_body_id id = add_moving(w, carom_shape_capsule(0.02, 0.5), vec(0, 0, 10), about_x(PI_ / 2), vec(0, 0, 0),
                                     vec(0, 500, 0));
         for (int i = 0; i < 30; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
         double t = 0.5, drop = 10 - pos(w, id).z;
@@ -184,9 +154,9 @@ static void test_fast_dynamic_bodies_meet(void **state)
             for (int g = 0; g < 3; g++) {
                 double dt = 1.0 / rates[r], half = 0.5 * gaps[g];
                 carom_world *w = world_preset(presets[p], 0);
-                carom_body_id a = add_body(w, carom_shape_sphere(0.01), vec(-half, 0, 0), about_x(0), vec(500, 0, 0),
+                carom_body_id a = add_moving(w, carom_shape_sphere(0.01), vec(-half, 0, 0), about_x(0), vec(500, 0, 0),
                                            vec(0, 0, 0));
-                carom_body_id b = add_body(w, carom_shape_sphere(0.01), vec(half, 0, 0), about_x(0), vec(-500, 0, 0),
+                carom_body_id b = add_moving(w, carom_shape_sphere(0.01), vec(half, 0, 0), about_x(0), vec(-500, 0, 0),
                                            vec(0, 0, 0));
                 int n = (int)ceil(2.0 * gaps[g] / 1000.0 / dt) + 4;
                 for (int i = 0; i < n; i++) {
@@ -200,9 +170,9 @@ static void test_fast_dynamic_bodies_meet(void **state)
                 carom_world_destroy(w);
 
                 w = world_preset(presets[p], 0);
-                carom_body_id s = add_body(w, carom_shape_sphere(0.01), vec(-half, 0, 0), about_x(0), vec(1000, 0, 0),
+                carom_body_id s = add_moving(w, carom_shape_sphere(0.01), vec(-half, 0, 0), about_x(0), vec(1000, 0, 0),
                                            vec(0, 0, 0));
-                carom_body_id box = add_body(w, carom_shape_box(0.025, 0.5, 0.5), vec(half, 0, 0), about_x(0),
+                carom_body_id box = add_moving(w, carom_shape_box(0.025, 0.5, 0.5), vec(half, 0, 0), about_x(0),
                                              vec(-200, 0, 0), vec(0, 0, 0));
                 int met = 0;
                 for (int i = 0; i < n; i++) {
@@ -272,7 +242,7 @@ static void test_issue17_finding6_struck_resting_body_stays_out(void **state)
                         double rad = radii[r];
                         carom_shape_def shape = kind ? carom_shape_capsule(rad, 2 * rad) : carom_shape_sphere(rad);
                         carom_quat lying = about_x(PI_ / 2);
-                        carom_body_id id = add_body(w, shape, vec(0, 0, rad), kind ? lying : about_x(0), vec(0, 0, 0),
+                        carom_body_id id = add_moving(w, shape, vec(0, 0, rad), kind ? lying : about_x(0), vec(0, 0, 0),
                                                     vec(0, 0, 0));
                         assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
                         /* k < 3: struck down; k = 3: sliding at the clamp */

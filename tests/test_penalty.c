@@ -11,34 +11,26 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
-
-static carom_vec3 cv(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
+#include "helpers.h"
 
 static carom_world *penalty_world(const char *preset, int implicit, double k)
 {
-    carom_world_def wd = carom_world_def_default();
-    assert_int_equal(carom_world_def_apply_preset(&wd, preset), CAROM_OK);
+    carom_world_def wd = preset_def(preset);
     wd.contact_model = CAROM_CONTACT_PENALTY;
     wd.penalty_implicit = implicit;
     wd.penalty_stiffness = k;
-    carom_world *w = carom_world_create(&wd);
-    assert_non_null(w);
-    carom_body_def g = carom_body_def_default();
-    g.type = CAROM_BODY_STATIC;
-    g.shape = carom_shape_plane(0, 0, 1, 0);
-    assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    carom_world *w = world_with(wd, 0, 0.0, 0.0);
+    add_ground(w);
     return w;
 }
 
-static carom_body_id add_box(carom_world *w, double z)
+static carom_body_id add_unit_box(carom_world *w, double z)
 {
     carom_body_def d = carom_body_def_default();
     d.shape = carom_shape_box(0.5, 0.5, 0.5);
     d.mass = 1.0;
-    d.position = cv(0, 0, z);
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
+    d.position = vec(0, 0, z);
+    return add_body(w, &d);
 }
 
 /* Ten unit boxes (1 kg) stacked on the ground: the top moves < 5 cm in 10 s. */
@@ -49,7 +41,7 @@ static void test_penalty_stack_of_ten(void **state)
     for (int p = 0; p < 3; p++) {
         carom_world *w = penalty_world(presets[p], 1, 0.0);
         carom_body_id box[10];
-        for (int i = 0; i < 10; i++) box[i] = add_box(w, 0.5 + i);
+        for (int i = 0; i < 10; i++) box[i] = add_unit_box(w, 0.5 + i);
         for (int i = 0; i < 600; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
         carom_vec3 top;
         assert_int_equal(carom_body_get_position(w, box[9], &top), CAROM_OK);
@@ -67,7 +59,7 @@ static void test_unstable_explicit_spring_refused(void **state)
 {
     (void)state;
     carom_world *w = penalty_world("default", 0, 1e7);
-    carom_body_id box = add_box(w, 0.49);
+    carom_body_id box = add_unit_box(w, 0.49);
     carom_vec3 before, after;
     assert_int_equal(carom_body_get_position(w, box, &before), CAROM_OK);
     assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_ERROR_INVALID_ARGUMENT);
@@ -107,7 +99,7 @@ static void test_automatic_explicit_spring_stable(void **state)
         g.type = CAROM_BODY_STATIC;
         g.shape = carom_shape_plane(0, 0, 1, 0);
         carom_body_create(w, &g);
-        carom_body_id box = add_box(w, 0.8);
+        carom_body_id box = add_unit_box(w, 0.8);
         double highest = 0;
         carom_vec3 p;
         for (int i = 0; i < (int)(5.0 / dts[k]); i++) {

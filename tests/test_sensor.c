@@ -12,6 +12,7 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 
 typedef struct event_log { int begin, end; carom_body_id sensor, other; } event_log;
 
@@ -36,16 +37,7 @@ static carom_body_id add_sensor(carom_world *w, carom_body_type type, double z, 
     d.position.z = z;
     d.sensor = 1;
     d.mask = mask;
-    return carom_body_create(w, &d);
-}
-
-static carom_body_id add_ball(carom_world *w, double x, double z)
-{
-    carom_body_def d = carom_body_def_default();
-    d.shape = carom_shape_sphere(0.25);
-    d.position.x = x;
-    d.position.z = z;
-    return carom_body_create(w, &d);
+    return add_body(w, &d);
 }
 
 /* A ball falls through a static sensor: one begin while it overlaps, one end
@@ -58,7 +50,7 @@ static void test_enter_and_leave(void **state)
         carom_world_def wd = carom_world_def_default();
         carom_world *w = carom_world_create(&wd), *twin = carom_world_create(&wd);
         carom_body_id s = add_sensor(w, CAROM_BODY_STATIC, 5, CAROM_MASK_ALL);
-        carom_body_id b = add_ball(w, 0.3, 8), tb = add_ball(twin, 0.3, 8);
+        carom_body_id b = add_sphere(w, 0.3, 0, 8, 0.25), tb = add_sphere(twin, 0.3, 0, 8, 0.25);
         event_log log = {0, 0, {0, 0}, {0, 0}};
         int begin_step = -1, end_step = -1;
         double entered_z = 0, left_z = 0;
@@ -97,7 +89,7 @@ static void test_destroyed_teleported_filtered(void **state)
     wd.gravity.z = 0;
     carom_world *w = carom_world_create(&wd);
     add_sensor(w, CAROM_BODY_STATIC, 0, ~(uint64_t)2);
-    carom_body_id inside = add_ball(w, 0.5, 0);
+    carom_body_id inside = add_sphere(w, 0.5, 0, 0, 0.25);
     event_log log = {0, 0, {0, 0}, {0, 0}};
     carom_world_step(w, 1.0 / 60);
     count_sensor_events(w, &log);
@@ -108,7 +100,7 @@ static void test_destroyed_teleported_filtered(void **state)
     assert_int_equal(log.end, 1);
     assert_true(carom_body_id_equal(log.other, inside) && !carom_body_is_valid(w, inside));
     /* teleported from one side to the other between steps */
-    carom_body_id t = add_ball(w, -5, 0);
+    carom_body_id t = add_sphere(w, -5, 0, 0, 0.25);
     carom_world_step(w, 1.0 / 60);
     carom_vec3 far = {5, 0, 0};
     carom_body_set_position(w, t, far);
@@ -143,7 +135,7 @@ static void test_sleeping_body(void **state)
     g.shape = carom_shape_box(5, 5, 0.5);
     g.position.z = -0.5;
     carom_body_create(w, &g);
-    carom_body_id b = add_ball(w, 0, 0.25);
+    carom_body_id b = add_sphere(w, 0, 0, 0.25, 0.25);
     carom_body_id s = add_sensor(w, CAROM_BODY_KINEMATIC, 10, CAROM_MASK_ALL);
     for (int i = 0; i < 120; i++) carom_world_step(w, 1.0 / 60);
     assert_false(carom_body_is_awake(w, b));
@@ -268,7 +260,7 @@ static void test_snapshot_round_trip(void **state)
     g.position.z = -0.5;
     g.category = 4;
     carom_body_create(w, &g);
-    carom_body_id a = add_ball(w, 0, 3.0), b = add_ball(w, 0.6, 2.4);
+    carom_body_id a = add_sphere(w, 0, 0, 3.0, 0.25), b = add_sphere(w, 0.6, 0, 2.4, 0.25);
     carom_body_set_filter(w, b, 1, ~(uint64_t)4, 0); /* b falls through the ground */
     for (int i = 0; i < 5; i++) carom_world_step(w, 1.0 / 60);
     size_t n = carom_world_snapshot(w, NULL, 0);

@@ -11,23 +11,10 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
-
-#define G 9.81
+#include "helpers.h"
 
 static const char *const presets[] = {"fast", "default", "accurate"};
 static const double step_rates[] = {15, 60, 240, 1000};
-
-static carom_vec3 vec(double x, double y, double z) { carom_vec3 v = {x, y, z}; return v; }
-
-static carom_world *world_preset(const char *preset, int gravity)
-{
-    carom_world_def d = carom_world_def_default();
-    assert_int_equal(carom_world_def_apply_preset(&d, preset), CAROM_OK);
-    if (!gravity) d.gravity = vec(0, 0, 0);
-    carom_world *w = carom_world_create(&d);
-    assert_non_null(w);
-    return w;
-}
 
 static carom_body_id add_box_asleep(carom_world *w, carom_vec3 p, double he, int awake)
 {
@@ -36,25 +23,13 @@ static carom_body_id add_box_asleep(carom_world *w, carom_vec3 p, double he, int
     d.shape = carom_shape_box(he, he, he);
     d.mass = 1.0;
     d.awake = awake;
-    carom_body_id id = carom_body_create(w, &d);
-    assert_false(carom_body_id_is_null(id));
-    return id;
+    return add_body(w, &d);
 }
 
-static carom_vec3 pos(carom_world *w, carom_body_id id)
+/* a 40 m x 40 m slab with its top at z = 0, centred at x0 */
+static void add_slab(carom_world *w, double x0)
 {
-    carom_vec3 p;
-    assert_int_equal(carom_body_get_position(w, id, &p), CAROM_OK);
-    return p;
-}
-
-static void add_ground(carom_world *w, double x0)
-{
-    carom_body_def g = carom_body_def_default();
-    g.type = CAROM_BODY_STATIC;
-    g.shape = carom_shape_box(20, 20, 0.5);
-    g.position = vec(x0, 0, -0.5);
-    assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    add_static(w, carom_shape_box(20, 20, 0.5), vec(x0, 0, -0.5));
 }
 
 /* A body created with awake = 0 in mid-air does not move for 2 s at any
@@ -93,7 +68,7 @@ static void test_created_asleep_wakes_when_touched(void **state)
     (void)state;
     for (int p = 0; p < 3; p++) {
         carom_world *w = world_preset(presets[p], 1);
-        add_ground(w, 0);
+        add_slab(w, 0);
         carom_body_id lower = add_box_asleep(w, vec(0, 0, 0.5), 0.5, 0);
         int woke = 0;
         for (int i = 0; i < 30; i++) {
