@@ -7,6 +7,7 @@
 #define CAROM_TEST_HELPERS_H
 
 #include <math.h>
+#include <stdint.h>
 
 #define G 9.81
 #define DT (1.0 / 60.0)
@@ -21,6 +22,35 @@
             fail();                                                                                \
         }                                                                                          \
     } while (0)
+
+/* xorshift64: the state is passed around, never global */
+static inline uint64_t xorshift64(uint64_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return *s;
+}
+
+/* uniform in [0, 1) from the top 53 bits */
+static inline double rnd(uint64_t *s) { return (double)(xorshift64(s) >> 11) / 9007199254740992.0; }
+
+/* silent unless they fail: |got - want| within rel |want|, within tol */
+static inline void check_rel(double got, double want, double rel, const char *what)
+{
+    if (!(fabs(got - want) <= rel * fabs(want))) {
+        print_error("%s: got %.9g, expected %.9g (rel %.3g)\n", what, got, want, rel);
+        fail();
+    }
+}
+
+static inline void check_abs(double got, double want, double tol, const char *what)
+{
+    if (!(fabs(got - want) <= tol)) {
+        print_error("%s: got %.9g, expected %.9g (abs %.3g)\n", what, got, want, tol);
+        fail();
+    }
+}
 
 #ifdef CAROM_CAROM_H
 

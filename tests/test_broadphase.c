@@ -11,16 +11,9 @@
 #include <math.h>
 #include <cmocka.h>
 #include "broadphase.h"
+#include "helpers.h"
 
 /* ---- helpers -------------------------------------------------------------- */
-
-static double rnd(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return (double)(*s >> 11) / 9007199254740992.0;
-}
 
 static aabb box_at(vec3 c, vec3 h)
 {

@@ -15,6 +15,7 @@
 #include <string.h>
 #include "vecmath.h"
 #include "impulse.h"
+#include "helpers.h"
 
 /* |got - want| within half a unit of want's 4th significant figure: the value
  * rounds to the same 4 figures as docs/physics.md's (or straddles it by rounding) */
@@ -23,22 +24,6 @@ static void check_sig4(double got, double want, const char *what)
     double tol = 0.5 * pow(10.0, floor(log10(fabs(want))) - 3.0);
     if (!(fabs(got - want) <= tol)) {
         print_error("%s: got %.9g, worked example %.9g (4 significant figures: within %.3g)\n", what, got, want, tol);
-        fail();
-    }
-}
-
-static void check_rel(double got, double want, double rel, const char *what)
-{
-    if (!(fabs(got - want) <= rel * fabs(want))) {
-        print_error("%s: got %.9g, expected %.9g (rel %.3g)\n", what, got, want, rel);
-        fail();
-    }
-}
-
-static void check_abs(double got, double want, double tol, const char *what)
-{
-    if (!(fabs(got - want) <= tol)) {
-        print_error("%s: got %.9g, expected %.9g (abs %.3g)\n", what, got, want, tol);
         fail();
     }
 }
@@ -339,15 +324,6 @@ static void test_golf_spin_club_strike(void **state)
 
 /* ---- 5. properties over random pairs ------------------------------------------ */
 
-static uint64_t xorshift64(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return *s;
-}
-
-static double rnd(uint64_t *s) { return (double)(xorshift64(s) >> 11) / 9007199254740992.0; }
 static double rsym(uint64_t *s) { return 2.0 * rnd(s) - 1.0; }
 static double loguni(uint64_t *s, double lo, double hi) { return lo * pow(hi / lo, rnd(s)); }
 static vec3 rvec(uint64_t *s, double scale) { return v3(scale * rsym(s), scale * rsym(s), scale * rsym(s)); }

@@ -12,6 +12,7 @@
 #include <math.h>
 #include <cmocka.h>
 #include "carom/carom.h"
+#include "helpers.h"
 #include "world.h"
 #include "narrowphase.h"
 #include "manifold.h"
@@ -48,11 +49,7 @@ static void add_floor(carom_world *w, floor_kind kind, const mover_case *mc)
 {
     carom_vec3 origin = {mc->far_x, mc->far_y, 0};
     if (kind == FLOOR_PLANE) {
-        carom_body_def bd = carom_body_def_default();
-        bd.type = CAROM_BODY_STATIC;
-        bd.shape = carom_shape_plane(0, 0, 1, 0);
-        bd.position = origin;
-        assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+        add_static(w, carom_shape_plane(0, 0, 1, 0), origin);
     } else if (kind == FLOOR_MESH || kind == FLOOR_MESH_RANDOM) {
         double *v; int *t; int nv, nt;
         scene_grid(20, 1.0, 0.0, kind == FLOOR_MESH_RANDOM ? 7u : 0u, &v, &nv, &t, &nt);

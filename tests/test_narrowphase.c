@@ -13,8 +13,8 @@
 #include "narrowphase.h"
 #include "shape.h"
 #include "mesh.h"
+#include "helpers.h"
 
-#define PI 3.14159265358979323846
 
 /* ---- helpers ------------------------------------------------------------------ */
 
@@ -249,7 +249,7 @@ static void test_sphere_capsule(void **state)
     NEAR_V(m.normal, v3_normalize(v3(0, -0.3, -0.5)), 1e-12);
     assert_int_equal(run_both(&s, at(0, 0, 2), &cap, at(0, 0, 0), 0.02, &m), 0);
     /* capsule lying along x (rotated about y), sphere above its middle */
-    assert_int_equal(run_both(&s, at(0.2, 0, 0.69), &cap, at_rot(0, 0, 0, v3(0, 1, 0), 0.5 * PI), 0.02, &m), 1);
+    assert_int_equal(run_both(&s, at(0.2, 0, 0.69), &cap, at_rot(0, 0, 0, v3(0, 1, 0), 0.5 * PI_), 0.02, &m), 1);
     NEAR(m.points[0].separation, -0.01, 1e-12);
     NEAR_V(m.normal, v3(0, 0, -1), 1e-12);
 }
@@ -259,7 +259,7 @@ static void test_capsule_pairs(void **state)
     (void)state;
     manifold m;
     shape c = capsule(0.25, 0.5), g = ground();
-    xform lying = at_rot(0, 0, 0.24, v3(0, 1, 0), 0.5 * PI);                        /* axis along x */
+    xform lying = at_rot(0, 0, 0.24, v3(0, 1, 0), 0.5 * PI_);                        /* axis along x */
     assert_int_equal(run_both(&c, lying, &g, at(0, 0, 0), 0.02, &m), 2);            /* lying: two points */
     for (int i = 0; i < 2; i++) {
         NEAR(m.points[i].separation, -0.01, 1e-12);
@@ -270,12 +270,12 @@ static void test_capsule_pairs(void **state)
     assert_int_equal(run_both(&c, at(0, 0, 0.74), &g, at(0, 0, 0), 0.02, &m), 1);   /* standing: one point */
     NEAR(m.points[0].separation, -0.01, 1e-12);
     /* tilted 30 degrees about y: the low end at z = 0.68 - 0.5 cos 30 - 0.25 */
-    double zl = 0.68 - 0.5 * cos(PI / 6) - 0.25;
-    assert_int_equal(run_both(&c, at_rot(0, 0, 0.68, v3(0, 1, 0), PI / 6), &g, at(0, 0, 0), 0.02, &m), 1);
+    double zl = 0.68 - 0.5 * cos(PI_ / 6) - 0.25;
+    assert_int_equal(run_both(&c, at_rot(0, 0, 0.68, v3(0, 1, 0), PI_ / 6), &g, at(0, 0, 0), 0.02, &m), 1);
     NEAR(m.points[0].separation, zl, 1e-12);
 
     /* parallel capsules side by side: two points, gap 0.45 - 0.5 */
-    xform beside = at_rot(0, 0.45, 0.24, v3(0, 1, 0), 0.5 * PI);
+    xform beside = at_rot(0, 0.45, 0.24, v3(0, 1, 0), 0.5 * PI_);
     assert_int_equal(run_both(&c, lying, &c, beside, 0.02, &m), 2);
     for (int i = 0; i < 2; i++) {
         NEAR(m.points[i].separation, -0.05, 1e-12);
@@ -283,12 +283,12 @@ static void test_capsule_pairs(void **state)
     }
     NEAR_V(m.normal, v3(0, 1, 0), 1e-12);
     /* parallel but offset along the axis by 0.6: the overlap [0.1, 0.5] of the segments */
-    xform shifted = at_rot(0.6, 0.45, 0.24, v3(0, 1, 0), 0.5 * PI);
+    xform shifted = at_rot(0.6, 0.45, 0.24, v3(0, 1, 0), 0.5 * PI_);
     assert_int_equal(run_both(&c, lying, &c, shifted, 0.02, &m), 2);
     NEAR(fmin(m.points[0].point.x, m.points[1].point.x), 0.1, 1e-12);
     NEAR(fmax(m.points[0].point.x, m.points[1].point.x), 0.5, 1e-12);
     /* crossed at 90 degrees: one point, gap 0.45 - 0.5 along z */
-    xform over = at_rot(0, 0, 0.24 + 0.45, v3(1, 0, 0), 0.5 * PI);                 /* axis along y */
+    xform over = at_rot(0, 0, 0.24 + 0.45, v3(1, 0, 0), 0.5 * PI_);                 /* axis along y */
     assert_int_equal(run_both(&c, lying, &c, over, 0.02, &m), 1);
     NEAR(m.points[0].separation, -0.05, 1e-12);
     NEAR_V(m.normal, v3(0, 0, 1), 1e-12);
@@ -346,7 +346,7 @@ static void test_box_plane(void **state)
     for (int i = 0; i < 4; i++) assert_true(m.points[i].separation < 0.01 * sin(th) + 1e-12);
     /* 45 degrees about x: an edge down, two points at depth 0.05 */
     double h = 0.5 * sqrt(2.0);
-    assert_int_equal(run_both(&b, at_rot(0, 0, h - 0.05, v3(1, 0, 0), 0.25 * PI), &g, at(0, 0, 0), 0.02, &m), 2);
+    assert_int_equal(run_both(&b, at_rot(0, 0, h - 0.05, v3(1, 0, 0), 0.25 * PI_), &g, at(0, 0, 0), 0.02, &m), 2);
     for (int i = 0; i < 2; i++) {
         NEAR(m.points[i].separation, -0.05, 1e-12);
         NEAR(fabs(m.points[i].point.x), 0.5, 1e-12);
@@ -355,7 +355,7 @@ static void test_box_plane(void **state)
     }
     assert_true(m.points[0].point.x * m.points[1].point.x < 0);
     /* a corner down (rotated about x then y by 45): lowest corner at z0 - sqrt(3)/2 ... one point */
-    quat q = q_mul(q_axis_angle(v3(0, 1, 0), atan(sqrt(0.5))), q_axis_angle(v3(1, 0, 0), 0.25 * PI));
+    quat q = q_mul(q_axis_angle(v3(0, 1, 0), atan(sqrt(0.5))), q_axis_angle(v3(1, 0, 0), 0.25 * PI_));
     xform xc = {v3(0, 0, 0.5 * sqrt(3.0) - 0.03), q};
     assert_int_equal(run_both(&b, xc, &g, at(0, 0, 0), 0.02, &m), 1);
     NEAR(m.points[0].separation, -0.03, 1e-12);
@@ -386,7 +386,7 @@ static void test_box_box(void **state)
     NEAR_V(m.normal, v3(0, -1, 0), 1e-12);
     NEAR(min_sep(&m), -0.1, 1e-12);
     /* rotated 45 degrees about z on top of another: a face contact, 4 points, depth 0.01 */
-    assert_int_equal(run_both(&b, at(0, 0, 0.5), &b, at_rot(0, 0, 1.49, v3(0, 0, 1), 0.25 * PI), 0.02, &m), 4);
+    assert_int_equal(run_both(&b, at(0, 0, 0.5), &b, at_rot(0, 0, 1.49, v3(0, 0, 1), 0.25 * PI_), 0.02, &m), 4);
     NEAR_V(m.normal, v3(0, 0, 1), 1e-12);
     for (int i = 0; i < 4; i++) {
         NEAR(m.points[i].separation, -0.01, 1e-12);
@@ -400,19 +400,19 @@ static void test_box_box(void **state)
     }
     /* edge on edge, crossed at 90 degrees: one point */
     double h = 0.5 * sqrt(2.0);
-    xform e1 = at_rot(0, 0, 0, v3(1, 0, 0), 0.25 * PI);                             /* top edge along x at z = h */
-    xform e2 = at_rot(0, 0, 2 * h - 0.02, v3(0, 1, 0), 0.25 * PI);                  /* bottom edge along y */
+    xform e1 = at_rot(0, 0, 0, v3(1, 0, 0), 0.25 * PI_);                             /* top edge along x at z = h */
+    xform e2 = at_rot(0, 0, 2 * h - 0.02, v3(0, 1, 0), 0.25 * PI_);                  /* bottom edge along y */
     assert_int_equal(run_both(&b, e1, &b, e2, 0.02, &m), 1);
     NEAR(m.points[0].separation, -0.02, 1e-9);
     NEAR_V(m.normal, v3(0, 0, 1), 1e-9);
     NEAR_V(m.points[0].point, v3(0, 0, h - 0.01), 1e-9);
     /* the same edges 0.01 apart: one speculative point */
-    xform e3 = at_rot(0, 0, 2 * h + 0.01, v3(0, 1, 0), 0.25 * PI);
+    xform e3 = at_rot(0, 0, 2 * h + 0.01, v3(0, 1, 0), 0.25 * PI_);
     assert_int_equal(run_both(&b, e1, &b, e3, 0.02, &m), 1);
     NEAR(m.points[0].separation, 0.01, 1e-9);
     /* separated beyond speculative */
     assert_int_equal(run_both(&b, at(0, 0, 0), &b, at(0, 0, 1.1), 0.02, &m), 0);
-    assert_int_equal(run_both(&b, e1, &b, at_rot(0, 0, 2 * h + 0.05, v3(0, 1, 0), 0.25 * PI), 0.02, &m), 0);
+    assert_int_equal(run_both(&b, e1, &b, at_rot(0, 0, 2 * h + 0.05, v3(0, 1, 0), 0.25 * PI_), 0.02, &m), 0);
     /* order swap on a generic overlap */
     run_both(&b, at(0, 0, 0), &b, at_rot(0.7, 0.1, 0.05, v3(0.2, 0.1, 1), 0.1), 0.02, &m);
     assert_true(m.count > 0);
@@ -429,7 +429,7 @@ static void test_cylinder_pairs(void **state)
         NEAR(hypot(m.points[i].point.x, m.points[i].point.y), 0.5, 1e-12);          /* on the rim */
         NEAR(m.points[i].point.z, -0.005, 1e-12);
     }
-    xform lying = at_rot(0, 0, 0.49, v3(1, 0, 0), 0.5 * PI);                        /* axis along y */
+    xform lying = at_rot(0, 0, 0.49, v3(1, 0, 0), 0.5 * PI_);                        /* axis along y */
     assert_int_equal(run_both(&cy, lying, &g, at(0, 0, 0), 0.02, &m), 2);           /* on its side: a line */
     for (int i = 0; i < 2; i++) {
         NEAR(m.points[i].separation, -0.01, 1e-12);
@@ -437,8 +437,8 @@ static void test_cylinder_pairs(void **state)
         NEAR(m.points[i].point.x, 0, 1e-12);
     }
     /* tilted about x by 30 degrees: the lowest rim point is one point */
-    double zl = 0.46 - 0.25 * cos(PI / 6) - 0.5 * sin(PI / 6);
-    assert_int_equal(run_both(&cy, at_rot(0, 0, 0.46, v3(1, 0, 0), PI / 6), &g, at(0, 0, 0), 0.02, &m), 1);
+    double zl = 0.46 - 0.25 * cos(PI_ / 6) - 0.5 * sin(PI_ / 6);
+    assert_int_equal(run_both(&cy, at_rot(0, 0, 0.46, v3(1, 0, 0), PI_ / 6), &g, at(0, 0, 0), 0.02, &m), 1);
     NEAR(m.points[0].separation, zl, 1e-12);
 
     /* cylinder standing on a box (libccd picks the face) */
@@ -448,7 +448,7 @@ static void test_cylinder_pairs(void **state)
     NEAR_V(m.normal, v3(0, 0, -1), 1e-9);
     for (int i = 0; i < m.count; i++) NEAR(m.points[i].point.z, 0.495, 1e-9);
     /* cylinder lying on a box: 2 points along the bottom line */
-    assert_int_equal(run_both(&cy, at_rot(0.2, 0.1, 0.99, v3(1, 0, 0), 0.5 * PI), &b, at(0, 0, 0), 0.02, &m), 2);
+    assert_int_equal(run_both(&cy, at_rot(0.2, 0.1, 0.99, v3(1, 0, 0), 0.5 * PI_), &b, at(0, 0, 0), 0.02, &m), 2);
     for (int i = 0; i < 2; i++) {
         NEAR(m.points[i].separation, -0.01, 1e-9);
         NEAR(m.points[i].point.x, 0.2, 1e-9);
@@ -471,7 +471,7 @@ static void test_hull_pairs(void **state)
     for (int i = 0; i < 3; i++) NEAR(m.points[i].separation, -0.01, 1e-12);
     NEAR_V(m.normal, v3(0, 0, -1), 1e-12);
     /* upside down (about x by pi): the apex (0,0,1) -> (0,0,-1); lift by 0.97: one point at depth 0.03 */
-    assert_int_equal(run_both(&h, at_rot(0, 0, 0.97, v3(1, 0, 0), PI), &g, at(0, 0, 0), 0.02, &m), 1);
+    assert_int_equal(run_both(&h, at_rot(0, 0, 0.97, v3(1, 0, 0), PI_), &g, at(0, 0, 0), 0.02, &m), 1);
     NEAR(m.points[0].separation, -0.03, 1e-12);
     NEAR_V(m.points[0].point, v3(0, 0, -0.015), 1e-12);
 
@@ -510,14 +510,6 @@ static void test_hull_pairs(void **state)
 
 /* ---- 2./3. random boxes against an independent brute-force SAT ----------------- */
 
-static uint64_t xorshift64(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return *s;
-}
-static double rnd(uint64_t *s) { return (double)(xorshift64(s) >> 11) / 9007199254740992.0; }
 static quat rnd_quat(uint64_t *s)
 {
     /* uniform on the sphere of unit quaternions: normalised Gaussian-free rejection */

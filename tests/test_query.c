@@ -25,13 +25,7 @@ static const double hull_points[] = {0.7, 0, 0,   -0.5, 0.1, 0,   0, 0.6, 0.1,  
                                      0, 0, 0.45,  0.05, 0.1, -0.5, 0.35, 0.3, 0.3, -0.3, -0.3, -0.25};
 
 static uint64_t rng_state = 0x243F6A8885A308D3ULL;
-static double urand(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) / 9007199254740992.0;
-}
+static double urand(void) { return rnd(&rng_state); }
 static double srand1(void) { return 2.0 * urand() - 1.0; }
 
 static carom_quat random_quat(void)

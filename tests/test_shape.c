@@ -14,8 +14,8 @@
 #include <math.h>
 #include <cmocka.h>
 #include "shape.h"
+#include "helpers.h"
 
-#define PI 3.14159265358979323846
 
 /* ---- helpers ------------------------------------------------------------------ */
 
@@ -56,15 +56,6 @@ static shape capsule(double r, double hh) { shape s = make(SHAPE_CAPSULE); s.rad
 static shape cylinder(double r, double hh) { shape s = make(SHAPE_CYLINDER); s.radius = r; s.half_height = hh; return s; }
 static shape hull_shape(hull *h) { shape s = make(SHAPE_HULL); s.hull = h; return s; }
 
-/* xorshift64: the state is passed around, never global */
-static double rnd(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return (double)(*s >> 11) / 9007199254740992.0;
-}
-
 static vec3 rnd_unit(uint64_t *s)
 {
     for (;;) {
@@ -83,7 +74,7 @@ static quat rnd_quat(uint64_t *s)
 /* n points spread evenly over the unit sphere (Fibonacci lattice) */
 static void fibonacci_sphere(double *pts, int n)
 {
-    double golden = PI * (3 - sqrt(5.0));
+    double golden = PI_ * (3 - sqrt(5.0));
     for (int i = 0; i < n; i++) {
         double z = 1 - (2 * i + 1.0) / n, r = sqrt(1 - z * z), a = golden * i;
         pts[3 * i] = r * cos(a);
@@ -194,9 +185,9 @@ static revolution revolve(double r, double hh, int caps)
             double z = 0.5 * (a + b) + 0.5 * (b - a) * x[k], dz = 0.5 * (b - a) * w[k];
             double r2 = capsule_radius2(z, r, hh);
             /* a disc of radius R at height z: area pi R^2, about x: R^2/4 + z^2 per unit mass */
-            out.volume += PI * r2 * dz;
-            out.ixx += PI * r2 * (r2 / 4 + z * z) * dz;
-            out.izz += PI * r2 * r2 / 2 * dz;
+            out.volume += PI_ * r2 * dz;
+            out.ixx += PI_ * r2 * (r2 / 4 + z * z) * dz;
+            out.izz += PI_ * r2 * r2 / 2 * dz;
         }
     }
     return out;
@@ -208,9 +199,9 @@ static void test_sphere_and_box_mass(void **state)
 {
     (void)state;
     shape s = sphere(0.3);
-    CHECK_CLOSE(shape_volume(&s), 4.0 / 3.0 * PI * 0.027, 1e-15, "sphere volume", 0);
+    CHECK_CLOSE(shape_volume(&s), 4.0 / 3.0 * PI_ * 0.027, 1e-15, "sphere volume", 0);
     mass_props mp = shape_mass_from_density(&s, 7800);
-    double m = 7800 * 4.0 / 3.0 * PI * 0.027, i = 0.4 * m * 0.09;
+    double m = 7800 * 4.0 / 3.0 * PI_ * 0.027, i = 0.4 * m * 0.09;
     CHECK_CLOSE(mp.mass, m, 1e-12 * m, "sphere mass from density", 0);
     check_mat(mp.inertia, m3_diag(v3(i, i, i)), 1e-12 * i, "sphere 2/5 m r^2", 0);
     check_vec(mp.center, v3_zero(), 0, "sphere centre", 0);
@@ -234,7 +225,7 @@ static void test_capsule_and_cylinder_mass(void **state)
     (void)state;
     double r = 0.3, hh = 0.5, h = 2 * hh, m = 2.0;
     shape c = capsule(r, hh);
-    double vc = PI * r * r * h, vs = 4.0 / 3.0 * PI * r * r * r;
+    double vc = PI_ * r * r * h, vs = 4.0 / 3.0 * PI_ * r * r * r;
     CHECK_CLOSE(shape_volume(&c), vc + vs, 1e-15, "capsule volume", 0);
     mass_props mp = shape_mass_from_mass(&c, m);
     /* cylinder part plus two hemispheres: a hemisphere's centroid sits 3r/8
@@ -260,7 +251,7 @@ static void test_capsule_and_cylinder_mass(void **state)
     h = 0.5;
     shape y = cylinder(r, hh);
     mass_props my = shape_mass_from_density(&y, 1000);
-    double mass = 1000 * PI * r * r * h;
+    double mass = 1000 * PI_ * r * r * h;
     CHECK_CLOSE(my.mass, mass, 1e-12, "cylinder mass from density", 0);
     check_mat(my.inertia, m3_diag(v3(mass * (3 * r * r + h * h) / 12, mass * (3 * r * r + h * h) / 12, mass * r * r / 2)),
               1e-12, "cylinder inertia", 0);
@@ -471,7 +462,7 @@ static void test_hull_of_sphere_points(void **state)
 {
     (void)state;
     static double pts[3 * 3000];
-    double sphere_volume = 4.0 / 3.0 * PI, last_gap = 1;
+    double sphere_volume = 4.0 / 3.0 * PI_, last_gap = 1;
     int sizes[3] = {100, 600, 3000};
     for (int k = 0; k < 3; k++) {
         int n = sizes[k];
@@ -485,7 +476,7 @@ static void test_hull_of_sphere_points(void **state)
          * the sphere at distance s from its centre, and s^2 averages rho^2 / 4
          * over it: a mean depth 3 rho^2 / 8, and a shell 3 times as thick in
          * volume, 9 rho^2 / 8 of the sphere */
-        double rho2 = 4 * PI / (2 * n) * 4 / (3 * sqrt(3.0)), expect = 9 * rho2 / 8;
+        double rho2 = 4 * PI_ / (2 * n) * 4 / (3 * sqrt(3.0)), expect = 9 * rho2 / 8;
         if (!(gap > 0.9 * expect && gap < 1.25 * expect)) {
             print_error("n = %d: volume gap %g, expected about %g\n", n, gap, expect);
             fail();
@@ -624,7 +615,7 @@ static void test_hull_topology_of_known_solids(void **state)
     for (int i = 0; i < 48; i++)
         for (int z = -1; z <= 1; z += 2, n++) {
             int corner = i / 4;
-            double t = (i % 4) / 4.0, a0 = 2 * PI * corner / 12, a1 = 2 * PI * (corner + 1) / 12;
+            double t = (i % 4) / 4.0, a0 = 2 * PI_ * corner / 12, a1 = 2 * PI_ * (corner + 1) / 12;
             pts[3 * n] = (1 - t) * cos(a0) + t * cos(a1);
             pts[3 * n + 1] = (1 - t) * sin(a0) + t * sin(a1);
             pts[3 * n + 2] = 0.5 * z;
@@ -634,7 +625,7 @@ static void test_hull_topology_of_known_solids(void **state)
     assert_int_equal(h->vertex_count, 24);
     assert_int_equal(h->face_count, 14);
     assert_int_equal(h->edge_count, 36);
-    CHECK_CLOSE(h->volume, 0.5 * 12 * sin(2 * PI / 12) * 1.0, 1e-12, "prism volume", 0);
+    CHECK_CLOSE(h->volume, 0.5 * 12 * sin(2 * PI_ / 12) * 1.0, 1e-12, "prism volume", 0);
     check_hull(h, pts, n, 3);
     hull_free(h);
     /* a cube's edge points listed before its corners: the edge points are
@@ -917,7 +908,7 @@ static int surface_samples(const shape *s, vec3 *out, int max)
         break;
     case SHAPE_CYLINDER:
         for (int i = 0; i < 2000 && n + 2 <= max; i++) {
-            double a = 2 * PI * i / 2000;
+            double a = 2 * PI_ * i / 2000;
             out[n++] = v3(s->radius * cos(a), s->radius * sin(a), s->half_height);
             out[n++] = v3(s->radius * cos(a), s->radius * sin(a), -s->half_height);
         }
@@ -1009,7 +1000,7 @@ static void test_bounds_contain_and_touch(void **state)
     aabb b = shape_aabb(&cy, up);
     check_vec(b.lo, v3(0.5, 1.5, 1.0), 1e-15, "upright cylinder lo", 0);
     check_vec(b.hi, v3(1.5, 2.5, 5.0), 1e-15, "upright cylinder hi", 0);
-    xform lying = {v3_zero(), q_axis_angle(v3(0, 1, 0), PI / 2)};
+    xform lying = {v3_zero(), q_axis_angle(v3(0, 1, 0), PI_ / 2)};
     b = shape_aabb(&cy, lying);
     check_vec(b.hi, v3(2.0, 0.5, 0.5), 1e-15, "lying cylinder hi", 0);
     /* a plane: huge, except on the solid side of an axis-aligned normal */
@@ -1022,7 +1013,7 @@ static void test_bounds_contain_and_touch(void **state)
     b = shape_aabb(&ground, (xform){v3(0, 0, 1), q_identity()});
     CHECK_CLOSE(b.hi.z, 3, 0, "raised plane", 0);
     /* turned a quarter about x, the normal points along -y: solid where y > -offset */
-    b = shape_aabb(&ground, (xform){v3_zero(), q_axis_angle(v3(1, 0, 0), PI / 2)});
+    b = shape_aabb(&ground, (xform){v3_zero(), q_axis_angle(v3(1, 0, 0), PI_ / 2)});
     CHECK_CLOSE(b.lo.y, -2, 1e-12, "turned plane", 0);
     assert_true(b.hi.y == 1e18 && b.hi.z == 1e18 && b.lo.z == -1e18);
     ground.plane_normal = v3_normalize(v3(1, 1, 1));
