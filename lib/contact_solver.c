@@ -3,8 +3,8 @@
  * (solver_wide.c) do the same four manifolds at a time; the formulas they
  * share are in constraint.h. */
 #include "contact_solver.h"
+#include "penalty.h"
 
-#define TWO_PI 6.283185307179586
 
 /* Rolling resistance c: a torque against the bodies' relative rolling,
  * capped at c R N. A body of mass m and inertia I_t about the rolling axis,
@@ -96,16 +96,7 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         p->tangent_impulse[1] = ws * c->warm[j].tangent_impulse[1];
         p->total_normal_impulse = 0.0;
         p->max_normal_impulse = 0.0;
-        if (ctx->penalty) {
-            double omega = TWO_PI * ctx->contact_hertz;
-            /* the automatic explicit spring (critically damped) stays stable:
-             * h^2 w^2 + 4 h w < 4 * 0.8 at h w <= 0.6 */
-            if (!ctx->penalty_implicit && omega * ctx->h > 0.6) omega = 0.6 / ctx->h;
-            p->penalty_k = ctx->penalty_stiffness > 0 ? ctx->penalty_stiffness : p->normal_mass * omega * omega;
-            p->penalty_c = ctx->penalty_damping > 0 ? ctx->penalty_damping : 2.0 * p->normal_mass * omega;
-            p->normal_impulse = 0.0;
-            p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
-        }
+        if (ctx->penalty) penalty_prepare_point(p, ctx);
         if (-mp->separation > deepest) deepest = -mp->separation;
     }
     prepare_rolling(c, A, B);

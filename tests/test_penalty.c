@@ -33,23 +33,103 @@ static carom_body_id add_unit_box(carom_world *w, double z)
     return add_body(w, &d);
 }
 
-/* Ten unit boxes (1 kg) stacked on the ground: the top moves < 5 cm in 10 s. */
+static carom_body_id add_box_at(carom_world *w, carom_vec3 at, double mass)
+{
+    carom_body_def d = carom_body_def_default();
+    d.shape = carom_shape_box(0.5, 0.5, 0.5);
+    d.mass = mass;
+    d.position = at;
+    return add_body(w, &d);
+}
+
+typedef struct column_result {
+    double worst;    /* largest distance of the top box from where it started */
+    double sideways; /* largest horizontal distance */
+    double final_dz; /* top box's height change at the end */
+} column_result;
+
+/* A column of n unit boxes of the given mass, sleep off (nothing may rest on
+ * sleeping), built bottom-up or top-down, at the world position at (the
+ * ground plane through at.z), for seconds at dt. */
+static column_result run_column(carom_world_def wd, int n, double mass, carom_vec3 at, int top_down, double dt,
+                                double seconds)
+{
+    wd.contact_model = CAROM_CONTACT_PENALTY;
+    wd.enable_sleep = 0;
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_plane(0, 0, 1, at.z);
+    assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    carom_body_id box[16];
+    for (int k = 0; k < n; k++) {
+        int i = top_down ? n - 1 - k : k;
+        box[i] = add_box_at(w, vec(at.x, at.y, at.z + 0.5 + i), mass);
+    }
+    column_result r = {0, 0, 0};
+    int steps = (int)(seconds / dt + 0.5);
+    for (int s = 0; s < steps; s++) {
+        assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+        carom_vec3 t;
+        assert_int_equal(carom_body_get_position(w, box[n - 1], &t), CAROM_OK);
+        double dx = t.x - at.x, dy = t.y - at.y, dz = t.z - (at.z + n - 0.5);
+        double side = sqrt(dx * dx + dy * dy), moved = sqrt(side * side + dz * dz);
+        if (moved > r.worst) r.worst = moved;
+        if (side > r.sideways) r.sideways = side;
+        r.final_dz = dz;
+    }
+    carom_world_destroy(w);
+    return r;
+}
+
+static const char *PRESETS[3] = {"fast", "default", "accurate"};
+
+/* Ten unit boxes (1 kg) stacked on the ground, sleep off: the top moves
+ * < 5 cm at any moment of 10 s (it settles by the springs' sag) and stays
+ * straight (< 1 mm sideways), at every preset, dt 1/30..1/1000, masses
+ * 0.1..100 kg, built either way up, far from the origin. */
 static void test_penalty_stack_of_ten(void **state)
 {
     (void)state;
-    static const char *presets[3] = {"fast", "default", "accurate"};
-    for (int p = 0; p < 3; p++) {
-        carom_world *w = penalty_world(presets[p], 1, 0.0);
-        carom_body_id box[10];
-        for (int i = 0; i < 10; i++) box[i] = add_unit_box(w, 0.5 + i);
-        for (int i = 0; i < 600; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
-        carom_vec3 top;
-        assert_int_equal(carom_body_get_position(w, box[9], &top), CAROM_OK);
-        double moved = sqrt(top.x * top.x + top.y * top.y + (top.z - 9.5) * (top.z - 9.5));
-        print_message("%s: top box moved %.4f m in 10 s\n", presets[p], moved);
-        assert_true(moved < 0.05);
-        carom_world_destroy(w);
-    }
+    const double dts[4] = {1.0 / 30, 1.0 / 60, 1.0 / 240, 1.0 / 1000};
+    const double masses[3] = {0.1, 1.0, 100.0};
+    const carom_vec3 places[2] = {{0, 0, 0}, {3e4, -2e4, 1e3}};
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 4; k++) {
+            int v = p + k; /* the variations in turn, not all combinations */
+            carom_world_def wd = preset_def(PRESETS[p]);
+            double seconds = dts[k] < 0.002 ? 3.0 : 10.0; /* dt 1/1000: 3 s keeps make check fast */
+            column_result r = run_column(wd, 10, masses[v % 3], places[v % 2], v % 2, dts[k], seconds);
+            print_message("%s dt 1/%.0f mass %g at x %g %s: top moved at most %.4f m, sideways %.2e m, "
+                          "ends %.4f m lower\n",
+                          PRESETS[p], 1 / dts[k], masses[v % 3], places[v % 2].x, v % 2 ? "top-down" : "bottom-up",
+                          r.worst, r.sideways, -r.final_dz);
+            assert_true(r.worst < 0.05);
+            assert_true(r.sideways < 1e-3);
+        }
+}
+
+/* With a given spring k per contact point (four corners per face) a column
+ * of n boxes of mass m settles by its static sag: interface j from the top
+ * carries j m g on 4 springs, so the top sinks m g n (n + 1) / (8 k). */
+static void test_penalty_column_sag(void **state)
+{
+    (void)state;
+    const double ks[2] = {5e3, 2e4}; /* h omega up to 1.7 at h = 1/240 (0.125 kg per corner) */
+    for (int p = 0; p < 3; p++)
+        for (int i = 0; i < 2; i++) {
+            int n = 10;
+            double m = 1.0;
+            carom_world_def wd = preset_def(PRESETS[p]);
+            wd.penalty_stiffness = ks[i];
+            wd.gravity = vec(0, 0, -9.81);
+            column_result r = run_column(wd, n, m, vec(0, 0, 0), 0, 1.0 / 60, 10.0);
+            double want = m * 9.81 * n * (n + 1) / (8.0 * ks[i]);
+            print_message("%s k %g: sag %.6f m (static %.6f m)\n", PRESETS[p], ks[i], -r.final_dz, want);
+            assert_true(fabs(-r.final_dz / want - 1) < 0.01);
+            assert_true(r.sideways < 1e-3);
+        }
 }
 
 /* k = 1e7 N/m on a 1 kg box at h = 1/240 s: h^2 k/m = 174 >> 4. The step is
@@ -118,6 +198,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_penalty_stack_of_ten),
+        cmocka_unit_test(test_penalty_column_sag),
         cmocka_unit_test(test_unstable_explicit_spring_refused),
         cmocka_unit_test(test_automatic_explicit_spring_stable),
     };
