@@ -10,6 +10,17 @@ int filter_bits_allow(const body_store *s, int a, int b)
     return (s->category[a] & s->filter_mask[b]) != 0 && (s->category[b] & s->filter_mask[a]) != 0;
 }
 
+int filter_pair_allowed(carom_world *w, int slot_a, int slot_b)
+{
+    const body_store *s = &w->bodies;
+    if (!filter_bits_allow(s, slot_a, slot_b)) return 0;
+    if (!w->pair_filter) return 1;
+    int ia = s->id_index[slot_a], ib = s->id_index[slot_b];
+    if (ia > ib) { int t = ia; ia = ib; ib = t; }
+    if (contact_find(&w->contacts, ia, ib) >= 0) return 1;
+    return w->pair_filter(w->pair_filter_context, world_make_id(w, ia), world_make_id(w, ib)) != 0;
+}
+
 CAROM_API carom_status carom_body_set_filter(carom_world *w, carom_body_id id, uint64_t category, uint64_t mask,
                                              int group)
 {

@@ -7,5 +7,10 @@
 
 /* 1 when the bits and groups of the bodies at slots a and b let them touch. */
 int filter_bits_allow(const body_store *s, int a, int b);
+/* The bits, then the world's pair filter for a pair with no contact yet
+ * (one that exists was admitted when it began): what continuous collision
+ * asks before it sweeps one body against another. */
+struct carom_world;
+int filter_pair_allowed(struct carom_world *w, int slot_a, int slot_b);
 
 #endif

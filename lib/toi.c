@@ -179,8 +179,9 @@ static int sweep_against(void *user, int id_index)
     const body_store *s = &ctx->w->bodies;
     int other = s->ids[id_index].slot;
     int self = ctx->slot;
-    if (other < 0 || other == self || !filter_bits_allow(s, self, other)) return 1;
+    if (other < 0 || other == self) return 1;
     if ((s->flags[other] | s->flags[self]) & BODY_SENSOR) return 1; /* sensors never stop a body */
+    if (!filter_pair_allowed(ctx->w, self, other)) return 1; /* the bits and the world's pair filter */
     double limit = ctx->fraction[self];
     /* a moving dynamic body can be stopped too: meeting sooner binds it */
     int other_stops = s->type[other] == CAROM_BODY_DYNAMIC && ctx->sweeps[other].moving;

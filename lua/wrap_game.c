@@ -511,6 +511,63 @@ static int lua_pre_solve(void *context, carom_body_id a, carom_body_id b, const 
     return keep;
 }
 
+static const char pair_filter_key = 'f'; /* registry: weak-keyed {world userdata = fn} */
+
+/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids). */
+static int dispatch_pair_filter(lua_State *L)
+{
+    const carom_body_id *a = lua_touserdata(L, 2), *b = lua_touserdata(L, 3);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, &pair_filter_key);
+    lua_pushvalue(L, 1);
+    lua_rawget(L, -2);
+    clua_push_body(L, 1, *a);
+    clua_push_body(L, 1, *b);
+    lua_call(L, 2, 1);
+    lua_pushboolean(L, !(lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))); /* only false refuses */
+    return 1;
+}
+
+static int lua_pair_filter(void *context, carom_body_id a, carom_body_id b)
+{
+    clua_world *lw = context;
+    lua_State *L = lw->stepping;
+    if (!L || lw->callback_failed) return 1;
+    int top = lua_gettop(L);
+    if (!lua_checkstack(L, 8)) return 1;
+    lua_pushcfunction(L, clua_traceback);
+    lua_pushcfunction(L, dispatch_pair_filter);
+    lua_pushvalue(L, 1);
+    lua_pushlightuserdata(L, &a);
+    lua_pushlightuserdata(L, &b);
+    int keep = 1;
+    if (lua_pcall(L, 3, 1, top + 1) != LUA_OK) {
+        lw->callback_failed = 1; /* step raises it afterwards, like a contact callback's */
+        lua_setiuservalue(L, 1, WORLD_UV_ERROR);
+    } else {
+        keep = lua_toboolean(L, -1);
+    }
+    lua_settop(L, top);
+    return keep;
+}
+
+/* world:set_pair_filter(fn or nil): fn(a, b) for each new pair the bits
+ * allow (contacts and continuous collision); returning false keeps them
+ * from touching. */
+static int world_set_pair_filter(lua_State *L)
+{
+    clua_world *lw = clua_check_world(L, 1, "set_pair_filter");
+    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TFUNCTION) clua_type_error(L, 2, "set_pair_filter", "function or nil");
+    if (lw->stepping) return luaL_error(L, "set_pair_filter: cannot change it inside a contact callback");
+    lua_settop(L, 2);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, &pair_filter_key);
+    lua_pushvalue(L, 1);
+    lua_pushvalue(L, 2);
+    lua_rawset(L, -3);
+    lw = clua_check_world(L, 1, "set_pair_filter");
+    carom_world_set_pair_filter(lw->world, lua_isfunction(L, 2) ? lua_pair_filter : NULL, lw);
+    return 0;
+}
+
 /* world:set_pre_solve(fn or nil): fn(a, b, manifold) before each touching
  * pair is solved; returning false leaves it out of this step. */
 static int world_set_pre_solve(lua_State *L)
@@ -532,7 +589,8 @@ void clua_open_game(lua_State *L)
 {
     static const luaL_Reg world_methods[] = {{"ray_cast_all", world_ray_cast_all}, {"shape_cast", world_shape_cast},
                                              {"overlap", world_overlap}, {"distance", world_distance},
-                                             {"set_pre_solve", world_set_pre_solve}, {NULL, NULL}};
+                                             {"set_pre_solve", world_set_pre_solve},
+                                             {"set_pair_filter", world_set_pair_filter}, {NULL, NULL}};
     static const luaL_Reg body_methods[] = {
         {"set_filter", body_set_filter}, {"filter", body_filter}, {"apply_angular_impulse", body_apply_angular_impulse},
         {"set_damping", body_set_damping}, {"damping", body_damping}, {"world_point", body_world_point},
@@ -546,6 +604,12 @@ void clua_open_game(lua_State *L)
     lua_setfield(L, -2, "__mode");
     lua_setmetatable(L, -2);
     lua_rawsetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
+    lua_newtable(L); /* pair filters likewise */
+    lua_createtable(L, 0, 1);
+    lua_pushliteral(L, "k");
+    lua_setfield(L, -2, "__mode");
+    lua_setmetatable(L, -2);
+    lua_rawsetp(L, LUA_REGISTRYINDEX, &pair_filter_key);
     luaL_getmetatable(L, CLUA_WORLD_MT);
     lua_getfield(L, -1, "__index");
     luaL_setfuncs(L, world_methods, 0);

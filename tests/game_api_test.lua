@@ -263,5 +263,44 @@ test("pre-solve: a one-way platform", function()
   raises("function or nil", w.set_pre_solve, w, 3)
 end)
 
+test("set_pair_filter: contacts and continuous collision, errors raised by step", function()
+  local w, g, ball = ground_and_ball({}, { position = {0, 0, 1} })
+  local calls = 0
+  w:set_pair_filter(function(a, b)
+    calls = calls + 1
+    assert((a == g and b == ball) or (a == ball and b == g))
+    return false
+  end)
+  w:step(1/60, 60)
+  local _, _, z = ball:position()
+  assert(z < 0 and calls > 0, "refused: it falls through the ground")
+  w:set_pair_filter(nil)
+  ball:set_position(0, 0, 1)
+  ball:set_velocity(0, 0, 0)
+  w:step(1/60, 90)
+  _, _, z = ball:position()
+  near(z, 0.25, 0.01, "allowed again: it lands")
+  -- a bullet through a thin wall the filter refuses (continuous collision asks it too)
+  local space = carom.world{ gravity = {0, 0, 0} }
+  local wall = space:add_body{ type = "static", shape = carom.box{ half_extents = {0.05, 2, 2} }, position = {5, 0, 0} }
+  local bullet = space:add_body{ shape = carom.sphere{ radius = 0.1 }, velocity = {300, 0, 0}, bullet = true }
+  space:set_pair_filter(function(a, b) return a ~= wall and b ~= wall end)
+  space:step(1/60, 10)
+  assert(bullet:position() > 40)
+  -- errors: a table keeps its value; destroying inside is refused with an error
+  local w2, _, b2 = ground_and_ball({}, { position = {0, 0, 1} })
+  w2:set_pair_filter(function() error({ why = "filter" }) end)
+  local ok, err = pcall(w2.step, w2, 1/60, 60)
+  assert(not ok and type(err) == "table" and err.why == "filter")
+  w2:set_pair_filter(function(a) a:destroy(); return true end)
+  b2:set_position(3, 0, 1)
+  ok, err = pcall(w2.step, w2, 1/60, 60)
+  assert(not ok and tostring(err):find("destroy", 1, true), tostring(err))
+  assert(#w2:bodies() == 2, "nothing destroyed")
+  raises("function or nil", w2.set_pair_filter, w2, 5)
+  w2:set_pair_filter(nil)
+  w2:step(1/60)
+end)
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end

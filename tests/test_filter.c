@@ -203,6 +203,57 @@ static void test_continuous_collision_honours_bits(void **state)
     }
 }
 
+typedef struct wall_filter {
+    carom_body_id wall;
+    int calls;
+} wall_filter;
+
+static int reject_wall(void *context, carom_body_id a, carom_body_id b)
+{
+    wall_filter *f = context;
+    f->calls++;
+    return !(carom_body_id_equal(a, f->wall) || carom_body_id_equal(b, f->wall));
+}
+
+/* The world's pair filter decides for continuous collision too: a bullet
+ * whose pair with a thin wall the filter refuses flies through it (its
+ * bits allow the pair, so only the callback can say no); allowed, it stops
+ * there. Far from the origin too. */
+static void test_continuous_collision_asks_pair_filter(void **state)
+{
+    (void)state;
+    const double origins[] = {0.0, 1e5};
+    for (int o = 0; o < 2; o++)
+        for (int refuse = 0; refuse < 2; refuse++) {
+            carom_world_def wd = carom_world_def_default();
+            wd.gravity.z = 0;
+            carom_world *w = carom_world_create(&wd);
+            double x0 = origins[o];
+            carom_body_def d = carom_body_def_default();
+            d.type = CAROM_BODY_STATIC;
+            d.shape = carom_shape_box(0.05, 2, 2);
+            d.position.x = x0 + 5;
+            wall_filter f = {carom_body_create(w, &d), 0};
+            d = carom_body_def_default();
+            d.shape = carom_shape_sphere(0.1);
+            d.position.x = x0;
+            d.linear_velocity.x = 300;
+            d.bullet = 1;
+            carom_body_id b = carom_body_create(w, &d);
+            assert_int_equal(carom_world_set_pair_filter(w, refuse ? reject_wall : NULL, &f), CAROM_OK);
+            for (int i = 0; i < 10; i++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+            carom_vec3 p;
+            carom_body_get_position(w, b, &p);
+            if (refuse) {
+                if (!(p.x > x0 + 40)) fail_msg("origin %g: the refused bullet stopped at x - x0 = %g", x0, p.x - x0);
+                assert_true(f.calls > 0);
+            } else {
+                assert_true(p.x < x0 + 5);
+            }
+            carom_world_destroy(w);
+        }
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
@@ -229,6 +280,7 @@ int main(void)
         cmocka_unit_test(test_group_overrides_bits),
         cmocka_unit_test(test_pair_filter_callback),
         cmocka_unit_test(test_continuous_collision_honours_bits),
+        cmocka_unit_test(test_continuous_collision_asks_pair_filter),
         cmocka_unit_test(test_bad_input),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
