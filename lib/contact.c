@@ -118,6 +118,14 @@ int contact_find(const contact_set *cs, int a, int b) { return contact_find_sub(
 
 int contact_add(contact_set *cs, int a, int b) { return contact_add_sub(cs, a, b, 0); }
 
+int contact_set_reserve(contact_set *cs, int n)
+{
+    while ((n + 1) * 2 > cs->map.capacity)
+        if (!map_grow(&cs->map)) return 0;
+    return array_reserve((void **)&cs->items, &cs->capacity, n, sizeof *cs->items) &&
+           array_reserve((void **)&cs->data, &cs->data_capacity, n, sizeof *cs->data);
+}
+
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;

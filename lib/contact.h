@@ -74,6 +74,8 @@ void contact_set_free(contact_set *cs);
 int contact_find(const contact_set *cs, int a, int b);
 /* Adds a contact for a new pair; returns its index or -1 on out of memory. */
 int contact_add(contact_set *cs, int a, int b);
+/* Room for n contacts without growing (restoring a snapshot). 0 on out of memory. */
+int contact_set_reserve(contact_set *cs, int n);
 /* The same for a pair's extra manifold number sub (> 0). */
 int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub);
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub);

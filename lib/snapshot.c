@@ -19,9 +19,10 @@
 #include "world.h"
 #include "ranges.h"
 #include "narrowphase.h"
+#include "mesh.h"
 
 #define SNAP_MAGIC "CAROMSNP"
-#define SNAP_VERSION 1u
+#define SNAP_VERSION 2u
 #define SNAP_HEADER_SIZE 32u
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
@@ -197,6 +198,140 @@ static int get_count(reader *r, size_t record, int max, const char *what)
     return (int)n;
 }
 
+/* ---- compact codes: varints, and doubles sent against a prediction -------------- */
+
+static void put_varint(writer *o, uint64_t v)
+{
+    while (v >= 0x80) { put_u8(o, (unsigned)(v & 0x7f) | 0x80u); v >>= 7; }
+    put_u8(o, (unsigned)v);
+}
+
+static uint64_t zigzag(int64_t v) { return ((uint64_t)v << 1) ^ (uint64_t)(v >> 63); }
+static int64_t unzigzag(uint64_t u) { return (int64_t)(u >> 1) ^ -(int64_t)(u & 1); }
+
+static uint64_t get_varint(reader *r, const char *what)
+{
+    uint64_t v = 0;
+    for (int shift = 0; shift < 64; shift += 7) {
+        unsigned b = get_u8(r, what);
+        if (r->failed) return 0;
+        if (shift == 63 && b > 1) break;
+        v |= (uint64_t)(b & 0x7f) << shift;
+        if (!(b & 0x80)) return v;
+    }
+    bad(r, "%s: varint longer than 64 bits", what);
+    return 0;
+}
+
+/* A varint that must fit an int in [lo, hi]. */
+static int get_small(reader *r, int64_t lo, int64_t hi, int is_signed, const char *what)
+{
+    uint64_t u = get_varint(r, what);
+    if (r->failed) return 0;
+    int64_t v = is_signed ? unzigzag(u) : (u > (uint64_t)INT64_MAX ? -1 : (int64_t)u);
+    if (v < lo || v > hi || (!is_signed && u > (uint64_t)INT64_MAX)) {
+        bad(r, "%s %lld is outside [%lld, %lld]", what, (long long)v, (long long)lo, (long long)hi);
+        return 0;
+    }
+    return (int)v;
+}
+
+static uint64_t f64_bits(double d)
+{
+    uint64_t v;
+    memcpy(&v, &d, 8);
+    return v;
+}
+
+/* Doubles sent as their bits XOR a prediction both sides compute from what is
+ * already written (exact predictions are common: derived fields, poses that
+ * did not change). Per value a 4-bit tag, two to a byte, before the group's
+ * payloads: 0 equal to the prediction; 1..8 the XOR's low t bytes (its high
+ * bytes are zero); 9..15 its high 16 - t bytes (its low t - 8 bytes are zero). */
+#define CODED_MAX 8
+static void put_coded(writer *o, const double *v, const double *pred, int n)
+{
+    uint64_t x[CODED_MAX];
+    int tag[CODED_MAX];
+    for (int i = 0; i < n; i++) {
+        x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
+        int lead = 0, trail = 0;
+        while (lead < 8 && !((x[i] >> (56 - 8 * lead)) & 0xff)) lead++;
+        while (trail < 8 && !((x[i] >> (8 * trail)) & 0xff)) trail++;
+        if (lead == 8) tag[i] = 0;
+        else if (trail > 0 && trail > lead) tag[i] = 8 + trail; /* keep the high 8 - trail bytes */
+        else tag[i] = 8 - lead;                                 /* keep the low 8 - lead bytes */
+    }
+    for (int i = 0; i < n; i += 2) put_u8(o, (unsigned)tag[i] | (i + 1 < n ? (unsigned)tag[i + 1] << 4 : 0u));
+    for (int i = 0; i < n; i++) {
+        if (tag[i] <= 8)
+            for (int k = 0; k < tag[i]; k++) put_u8(o, (unsigned)(x[i] >> (8 * k)) & 0xffu);
+        else
+            for (int k = tag[i] - 8; k < 8; k++) put_u8(o, (unsigned)(x[i] >> (8 * k)) & 0xffu);
+    }
+}
+
+/* The reader's side; every value decoded must be finite. */
+static void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
+{
+    int tag[CODED_MAX];
+    for (int i = 0; i < n; i += 2) {
+        unsigned b = get_u8(r, what);
+        tag[i] = (int)(b & 15);
+        if (i + 1 < n) tag[i + 1] = (int)(b >> 4);
+        else if (b >> 4 && !r->failed) bad(r, "%s: unused tag bits set", what);
+    }
+    for (int i = 0; i < n; i++) {
+        out[i] = 0;
+        if (r->failed) continue;
+        uint64_t x = 0;
+        int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
+        if (!need(r, (size_t)(to - from), what)) continue;
+        for (int k = from; k < to; k++) x |= (uint64_t)r->buf[r->pos++] << (8 * k);
+        uint64_t bits = x ^ f64_bits(pred[i]);
+        memcpy(&out[i], &bits, 8);
+        if (!isfinite(out[i])) bad(r, "%s is not finite", what);
+    }
+}
+
+static void put_coded_v3(writer *o, vec3 v, vec3 pred)
+{
+    double a[3] = {v.x, v.y, v.z}, p[3] = {pred.x, pred.y, pred.z};
+    put_coded(o, a, p, 3);
+}
+
+static vec3 get_coded_v3(reader *r, vec3 pred, const char *what)
+{
+    double a[3], p[3] = {pred.x, pred.y, pred.z};
+    get_coded(r, a, p, 3, what);
+    return v3(a[0], a[1], a[2]);
+}
+
+static void put_coded_q(writer *o, quat q, quat pred)
+{
+    double a[4] = {q.w, q.x, q.y, q.z}, p[4] = {pred.w, pred.x, pred.y, pred.z};
+    put_coded(o, a, p, 4);
+}
+
+static quat get_coded_q(reader *r, quat pred, const char *what)
+{
+    double a[4], p[4] = {pred.w, pred.x, pred.y, pred.z};
+    get_coded(r, a, p, 4, what);
+    quat q = {a[0], a[1], a[2], a[3]};
+    return q;
+}
+
+static void put_coded1(writer *o, double v, double pred) { put_coded(o, &v, &pred, 1); }
+static double get_coded1(reader *r, double pred, const char *what)
+{
+    double v;
+    get_coded(r, &v, &pred, 1, what);
+    return v;
+}
+
+static int v3_is_zero(vec3 v) { return f64_bits(v.x) == 0 && f64_bits(v.y) == 0 && f64_bits(v.z) == 0; }
+static int same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+
 /* ---- checksum: 64-bit, eight bytes at a time (snapshots are megabytes) ---------- */
 
 static uint64_t checksum(const unsigned char *p, size_t n)
@@ -296,6 +431,57 @@ static void write_shape(writer *o, const shape *s)
         put_m3(o, h->unit_inertia);
         break;
     }
+    case SHAPE_MESH: {
+        /* whole, tree included: rebuilding it could order the triangles
+         * differently, and their order is what contacts and rays report */
+        const tri_mesh *m = s->mesh;
+        put_u8(o, (unsigned)m->two_sided);
+        put_i32(o, m->vertex_count);
+        put_i32(o, m->triangle_count);
+        put_i32(o, m->node_count);
+        for (int i = 0; i < m->vertex_count; i++) put_v3(o, m->vertices[i]);
+        for (int t = 0; t < m->triangle_count; t++) {
+            for (int k = 0; k < 3; k++) put_i32(o, m->triangles[t][k]);
+            put_i32(o, m->source_index[t]);
+            put_u8(o, m->active[t]);
+        }
+        for (int i = 0; i < m->node_count; i++) {
+            put_v3(o, m->nodes[i].box.lo);
+            put_v3(o, m->nodes[i].box.hi);
+            put_i32(o, m->nodes[i].first);
+            put_i32(o, m->nodes[i].count);
+        }
+        break;
+    }
+    case SHAPE_HEIGHTFIELD: {
+        const height_field *h = s->field;
+        int cells = (h->rows - 1) * (h->columns - 1), holes = 0;
+        for (int i = 0; i < cells; i++) holes += h->hole[i] != 0;
+        put_i32(o, h->rows);
+        put_i32(o, h->columns);
+        put_f64(o, h->cell_x);
+        put_f64(o, h->cell_y);
+        for (int i = 0; i < h->rows * h->columns; i++) put_f64(o, h->heights[i]);
+        put_i32(o, holes);
+        for (int i = 0; i < cells; i++)
+            if (h->hole[i]) put_i32(o, i);
+        break;
+    }
+    case SHAPE_COMPOUND: {
+        const compound *c = s->compound;
+        put_i32(o, c->count);
+        for (int i = 0; i < c->count; i++) {
+            put_v3(o, c->poses[i].p);
+            put_q(o, c->poses[i].q);
+            put_f64(o, c->friction[i]);
+            put_f64(o, c->restitution[i]);
+            put_f64(o, c->density[i]);
+            put_f64(o, c->rolling_resistance[i]);
+            put_u8(o, (unsigned)c->combine[i]);
+            write_shape(o, &c->children[i]);
+        }
+        break;
+    }
     }
 }
 
@@ -358,7 +544,157 @@ static hull *read_hull(reader *r)
     return h;
 }
 
-static int read_shape(reader *r, shape *s, int body_type)
+
+/* Every index is checked: triangles name vertices, leaves name triangles, and
+ * every node but the root is the child of exactly one inner node above it,
+ * so the tree is a tree and its walks end. */
+static tri_mesh *read_mesh(reader *r)
+{
+    int two_sided = (int)get_u8(r, "mesh two-sided flag");
+    int nv = get_i32(r, "mesh vertex count"), nt = get_i32(r, "mesh triangle count"), nn = get_i32(r, "mesh node count");
+    if (r->failed) return NULL;
+    if (two_sided > 1 || nv < 3 || nv > 100000000 || nt < 1 || nt > 100000000 || nn < 1 || nn > 2 * nt)
+        return bad(r, "mesh counts (%d vertices, %d triangles, %d nodes) are out of range", nv, nt, nn), NULL;
+    if (!need(r, (size_t)nv * 24 + (size_t)nt * 17 + (size_t)nn * 56, "mesh")) return NULL;
+    tri_mesh *m = calloc(1, sizeof *m);
+    if (!m) return bad(r, "out of memory"), NULL;
+    m->two_sided = two_sided;
+    m->vertex_count = nv;
+    m->triangle_count = nt;
+    m->node_count = nn;
+    m->vertices = malloc(sizeof *m->vertices * (size_t)nv);
+    m->triangles = malloc(sizeof *m->triangles * (size_t)nt);
+    m->source_index = malloc(sizeof *m->source_index * (size_t)nt);
+    m->active = malloc((size_t)nt);
+    m->nodes = malloc(sizeof *m->nodes * (size_t)nn);
+    unsigned char *parents = calloc((size_t)nn, 1);
+    if (!m->vertices || !m->triangles || !m->source_index || !m->active || !m->nodes || !parents) {
+        free(parents);
+        mesh_free(m);
+        return bad(r, "out of memory"), NULL;
+    }
+    for (int i = 0; i < nv && !r->failed; i++) {
+        m->vertices[i] = get_v3(r, "mesh vertex");
+        vec3 v = m->vertices[i];
+        if (!r->failed && !(fabs(v.x) <= RANGE_LENGTH_MAX && fabs(v.y) <= RANGE_LENGTH_MAX && fabs(v.z) <= RANGE_LENGTH_MAX))
+            bad(r, "mesh vertex %d is beyond 1e6 m", i);
+    }
+    for (int t = 0; t < nt && !r->failed; t++) {
+        for (int k = 0; k < 3; k++) m->triangles[t][k] = get_i32(r, "mesh triangle");
+        m->source_index[t] = get_i32(r, "mesh triangle source");
+        m->active[t] = (uint8_t)get_u8(r, "mesh triangle edges");
+        const int *v = m->triangles[t];
+        if (!r->failed && (v[0] < 0 || v[0] >= nv || v[1] < 0 || v[1] >= nv || v[2] < 0 || v[2] >= nv || v[0] == v[1] ||
+                           v[1] == v[2] || v[2] == v[0] || m->source_index[t] < 0 || m->active[t] > 7))
+            bad(r, "mesh triangle %d has bad vertices, source index or edge bits", t);
+    }
+    for (int i = 0; i < nn && !r->failed; i++) {
+        mesh_node *nd = &m->nodes[i];
+        nd->box.lo = get_v3(r, "mesh node");
+        nd->box.hi = get_v3(r, "mesh node");
+        nd->first = get_i32(r, "mesh node");
+        nd->count = get_i32(r, "mesh node");
+        if (r->failed) break;
+        if (!(nd->box.lo.x <= nd->box.hi.x && nd->box.lo.y <= nd->box.hi.y && nd->box.lo.z <= nd->box.hi.z))
+            bad(r, "mesh node %d bounds are inverted", i);
+        else if (nd->count > 0 ? nd->first < 0 || nd->first > nt - nd->count
+                               : nd->count < 0 || nd->first <= i || nd->first > nn - 2 || parents[nd->first] || parents[nd->first + 1])
+            bad(r, "mesh node %d has children or triangles out of range", i);
+        else if (nd->count == 0)
+            parents[nd->first] = parents[nd->first + 1] = 1;
+    }
+    for (int i = 1; i < nn && !r->failed; i++)
+        if (!parents[i]) bad(r, "mesh node %d is in no tree", i);
+    free(parents);
+    if (r->failed) { mesh_free(m); return NULL; }
+    return m;
+}
+
+/* Built again by heightfield_build, which checks every value. */
+static height_field *read_field(reader *r)
+{
+    int rows = get_i32(r, "height field rows"), columns = get_i32(r, "height field columns");
+    double cx = get_f64(r, "height field cell"), cy = get_f64(r, "height field cell");
+    if (r->failed) return NULL;
+    if (rows < 2 || columns < 2 || (double)rows * columns > 1e8)
+        return bad(r, "height field of %d x %d points", rows, columns), NULL;
+    size_t points = (size_t)rows * (size_t)columns;
+    if (!need(r, points * 8 + 4, "height field")) return NULL;
+    double *heights = malloc(sizeof *heights * points);
+    if (!heights) return bad(r, "out of memory"), NULL;
+    for (size_t i = 0; i < points; i++) heights[i] = get_f64(r, "height");
+    int cells = (rows - 1) * (columns - 1);
+    int holes = get_count(r, 4, cells, "height field hole count");
+    int *hole = malloc(sizeof *hole * (size_t)(holes > 0 ? holes : 1));
+    if (!hole) { free(heights); return bad(r, "out of memory"), NULL; }
+    for (int i = 0; i < holes; i++) {
+        hole[i] = get_i32(r, "height field hole");
+        if (!r->failed && i > 0 && hole[i] <= hole[i - 1]) bad(r, "height field holes are not increasing");
+    }
+    height_field *h = NULL;
+    if (!r->failed) {
+        char why[160];
+        h = heightfield_build(heights, rows, columns, cx, cy, hole, holes, why, (int)sizeof why);
+        if (!h) bad(r, "%s", why);
+    }
+    free(heights);
+    free(hole);
+    return h;
+}
+
+static int read_shape(reader *r, shape *s, int body_type, int child);
+
+static compound *read_compound(reader *r)
+{
+    int n = get_i32(r, "compound child count");
+    if (r->failed) return NULL;
+    if (n < 1 || n > 256) return bad(r, "compound of %d children", n), NULL;
+    if (!need(r, (size_t)n * 99, "compound")) return NULL;
+    compound *c = calloc(1, sizeof *c);
+    if (c) {
+        c->children = calloc((size_t)n, sizeof *c->children);
+        c->poses = malloc(sizeof *c->poses * (size_t)n);
+        c->friction = malloc(sizeof *c->friction * (size_t)n);
+        c->restitution = malloc(sizeof *c->restitution * (size_t)n);
+        c->density = malloc(sizeof *c->density * (size_t)n);
+        c->rolling_resistance = malloc(sizeof *c->rolling_resistance * (size_t)n);
+        c->combine = malloc(sizeof *c->combine * (size_t)n);
+    }
+    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density || !c->rolling_resistance ||
+        !c->combine) {
+        compound_free(c);
+        return bad(r, "out of memory"), NULL;
+    }
+    for (int i = 0; i < n; i++) {
+        c->poses[i].p = get_v3(r, "compound child pose");
+        c->poses[i].q = get_q(r, "compound child pose");
+        c->friction[i] = get_f64(r, "compound child friction");
+        c->restitution[i] = get_f64(r, "compound child restitution");
+        c->density[i] = get_f64(r, "compound child density");
+        c->rolling_resistance[i] = get_f64(r, "compound child rolling resistance");
+        c->combine[i] = (int)get_u8(r, "compound child combine mode");
+        if (r->failed) break;
+        vec3 p = c->poses[i].p;
+        quat q = c->poses[i].q;
+        if (!(fabs(p.x) <= RANGE_LENGTH_MAX && fabs(p.y) <= RANGE_LENGTH_MAX && fabs(p.z) <= RANGE_LENGTH_MAX) ||
+            fabs(sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) > 1e-6) {
+            bad(r, "compound child %d pose out of range", i);
+            break;
+        }
+        if (!(c->friction[i] >= 0 && c->friction[i] <= RANGE_FRICTION_MAX && c->restitution[i] >= 0 &&
+              c->restitution[i] <= 1 && c->density[i] >= RANGE_DENSITY_MIN && c->density[i] <= RANGE_DENSITY_MAX &&
+              c->rolling_resistance[i] >= 0 && c->rolling_resistance[i] <= RANGE_FRICTION_MAX && c->combine[i] <= CAROM_COMBINE_MAX)) {
+            bad(r, "compound child %d material out of range", i);
+            break;
+        }
+        c->count = i + 1; /* its shape is owned from here: freed on a failure */
+        if (!read_shape(r, &c->children[i], CAROM_BODY_DYNAMIC, 1)) break;
+    }
+    if (r->failed) { compound_free(c); return NULL; }
+    return c;
+}
+
+static int read_shape(reader *r, shape *s, int body_type, int child)
 {
     memset(s, 0, sizeof *s);
     s->type = (int)get_u8(r, "shape type");
@@ -385,10 +721,21 @@ static int read_shape(reader *r, shape *s, int body_type)
         s->plane_offset = get_f64(r, "plane offset");
         if (!r->failed && fabs(v3_len(s->plane_normal) - 1.0) > 1e-9) return bad(r, "plane normal is not unit");
         if (!r->failed && !(fabs(s->plane_offset) <= RANGE_COORDINATE_MAX)) return bad(r, "plane offset beyond 1e12 m");
-        if (!r->failed && body_type != CAROM_BODY_STATIC) return bad(r, "a plane on a body that is not static");
+        if (!r->failed && (child || body_type != CAROM_BODY_STATIC)) return bad(r, "a plane on a body that is not static");
         break;
     case SHAPE_HULL:
         s->hull = read_hull(r);
+        break;
+    case SHAPE_MESH:
+    case SHAPE_HEIGHTFIELD:
+        if (child) return bad(r, "a compound child that is a mesh or height field");
+        if (body_type == CAROM_BODY_DYNAMIC) return bad(r, "a mesh or height field on a dynamic body");
+        if (s->type == SHAPE_MESH) s->mesh = read_mesh(r);
+        else s->field = read_field(r);
+        break;
+    case SHAPE_COMPOUND:
+        if (child) return bad(r, "a compound inside a compound");
+        s->compound = read_compound(r);
         break;
     default:
         return bad(r, "unknown shape type %d", s->type);
@@ -400,97 +747,289 @@ static int read_shape(reader *r, shape *s, int body_type)
 
 #define BODY_KNOWN_FLAGS (BODY_LOCK_ROTATION | BODY_LOCK_PLANE | BODY_BULLET | BODY_AWAKE | BODY_ENABLE_SLEEP | BODY_HAS_FORCE | \
                           BODY_SENSOR)
+/* the flags a body's class holds; the rest are per body */
+#define BODY_STATE_FLAGS (BODY_AWAKE | BODY_HAS_FORCE)
 #define CONTACT_KNOWN_FLAGS \
     (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_SIM | CONTACT_REUSABLE | CONTACT_APART | CONTACT_ANY_TOUCHING)
 
-static void write_world(writer *o, const carom_world *w)
+/* A body's class: everything most bodies share with others (type, shape, mass
+ * properties, material, filter), written once in a table and named by index. */
+static void write_class(writer *o, const body_store *s, int i)
+{
+    put_u8(o, (unsigned)s->type[i]);
+    put_u32(o, s->flags[i] & ~(uint32_t)BODY_STATE_FLAGS);
+    put_v3(o, s->local_center[i]);
+    put_f64(o, s->mass[i]);
+    put_m3(o, s->inertia_local[i]);
+    put_f64(o, s->friction[i]);
+    put_f64(o, s->restitution[i]);
+    put_f64(o, s->linear_damping[i]);
+    put_f64(o, s->angular_damping[i]);
+    put_f64(o, s->gravity_scale[i]);
+    put_v3(o, s->plane_normal[i]);
+    put_u64(o, s->category[i]);
+    put_u64(o, s->filter_mask[i]);
+    put_i32(o, s->group[i]);
+    put_f64(o, s->force_threshold[i]);
+    put_f64(o, s->rolling_resistance[i]);
+    put_u8(o, (unsigned)s->combine[i]);
+    write_shape(o, &s->shapes[i]);
+}
+
+static uint64_t hash_bytes(const unsigned char *p, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ULL;
+    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
+    return h;
+}
+
+/* The class table: classes in order of first use, each body's class index. */
+typedef struct class_table {
+    unsigned char *bytes;   /* the classes, one after another */
+    size_t size;
+    size_t *start;          /* per class: offset in bytes (count + 1 entries) */
+    int count;
+    int *of_body;           /* per slot */
+} class_table;
+
+static void class_table_free(class_table *t)
+{
+    free(t->bytes);
+    free(t->start);
+    free(t->of_body);
+}
+
+static int build_classes(const body_store *s, class_table *t)
+{
+    memset(t, 0, sizeof *t);
+    int n = s->count;
+    size_t total = 0;
+    for (int i = 0; i < n; i++) {
+        writer m = {NULL, 0, 0};
+        write_class(&m, s, i);
+        total += m.pos;
+    }
+    int cap = 16;
+    while (cap < 2 * n) cap *= 2;
+    int *slots = malloc(sizeof *slots * (size_t)cap);
+    uint64_t *hashes = malloc(sizeof *hashes * (size_t)cap);
+    t->bytes = malloc(total > 0 ? total : 1);
+    t->start = malloc(sizeof *t->start * (size_t)(n + 1));
+    t->of_body = malloc(sizeof *t->of_body * (size_t)(n > 0 ? n : 1));
+    if (!slots || !hashes || !t->bytes || !t->start || !t->of_body) {
+        free(slots);
+        free(hashes);
+        class_table_free(t);
+        return 0;
+    }
+    for (int k = 0; k < cap; k++) slots[k] = -1;
+    t->start[0] = 0;
+    for (int i = 0; i < n; i++) {
+        size_t at = t->start[t->count];
+        writer o = {t->bytes, total, at};
+        write_class(&o, s, i);
+        size_t len = o.pos - at;
+        uint64_t h = hash_bytes(t->bytes + at, len);
+        int k = (int)(h & (uint64_t)(cap - 1));
+        while (slots[k] >= 0) {
+            int c = slots[k];
+            if (hashes[k] == h && t->start[c + 1] - t->start[c] == len && memcmp(t->bytes + t->start[c], t->bytes + at, len) == 0)
+                break;
+            k = (k + 1) & (cap - 1);
+        }
+        if (slots[k] < 0) {
+            slots[k] = t->count;
+            hashes[k] = h;
+            t->start[++t->count] = at + len;
+        }
+        t->of_body[i] = slots[k];
+    }
+    t->size = t->start[t->count];
+    free(slots);
+    free(hashes);
+    return 1;
+}
+
+/* What the reader predicts a body's fat bounds to be: its bounds now, fattened
+ * as a body at rest is (most bodies in a snapshot last moved their proxy
+ * where they still are, or near it). */
+static aabb predicted_fat_box(const carom_world *w, int slot)
+{
+    return world_body_fat_aabb(w, slot, WORLD_AABB_MARGIN);
+}
+
+/* body record bits */
+enum {
+    REC_AWAKE = 1, REC_FORCE_FLAG = 2, REC_MOVED = 4, REC_VELOCITY = 8, REC_SPIN = 16, REC_FORCE = 32,
+    REC_SLEEP_TIME = 64, REC_PREVIOUS = 128, REC_FAT = 256, REC_TORQUE = 512
+};
+
+static void write_bodies(writer *o, const carom_world *w, const class_table *t)
+{
+    const body_store *s = &w->bodies;
+    put_varint(o, (uint64_t)t->count);
+    put_bytes(o, t->bytes, t->size);
+    put_varint(o, (uint64_t)s->count);
+    vec3 last_center = v3(0, 0, 0);
+    quat last_rotation = {1, 0, 0, 0};
+    double last_sleep = 0;
+    for (int i = 0; i < s->count; i++) {
+        xform x = body_xform(s, i);
+        aabb fat = predicted_fat_box(w, i);
+        int same_fat = same_bits(&fat, &s->fat_box[i], sizeof fat);
+        int same_previous = same_bits(&x.p, &s->previous_origin[i], sizeof x.p) &&
+                            same_bits(&x.q, &s->previous_rotation[i], sizeof x.q);
+        unsigned bits = ((s->flags[i] & BODY_AWAKE) ? REC_AWAKE : 0) | ((s->flags[i] & BODY_HAS_FORCE) ? REC_FORCE_FLAG : 0) |
+                        (bp_is_moved(w->bp, s->proxy[i]) ? REC_MOVED : 0) | (v3_is_zero(s->velocity[i]) ? 0 : REC_VELOCITY) |
+                        (v3_is_zero(s->angular_velocity[i]) ? 0 : REC_SPIN) | (v3_is_zero(s->force[i]) ? 0 : REC_FORCE) |
+                        (f64_bits(s->sleep_time[i]) == 0 ? 0 : REC_SLEEP_TIME) | (same_previous ? 0 : REC_PREVIOUS) |
+                        (same_fat ? 0 : REC_FAT) | (v3_is_zero(s->torque[i]) ? 0 : REC_TORQUE);
+        put_varint(o, bits);
+        put_varint(o, (uint64_t)t->of_body[i]);
+        put_coded_v3(o, s->center[i], last_center);
+        put_coded_q(o, s->rotation[i], last_rotation);
+        last_center = s->center[i];
+        last_rotation = s->rotation[i];
+        if (bits & REC_VELOCITY) put_coded_v3(o, s->velocity[i], v3(0, 0, 0));
+        if (bits & REC_SPIN) put_coded_v3(o, s->angular_velocity[i], v3(0, 0, 0));
+        if (bits & REC_FORCE) put_coded_v3(o, s->force[i], v3(0, 0, 0));
+        if (bits & REC_TORQUE) put_coded_v3(o, s->torque[i], v3(0, 0, 0));
+        if (bits & REC_SLEEP_TIME) { put_coded1(o, s->sleep_time[i], last_sleep); last_sleep = s->sleep_time[i]; }
+        if (s->flags[i] & BODY_LOCK_PLANE) put_coded1(o, s->plane_offset[i], v3_dot(s->plane_normal[i], s->center[i]));
+        if (bits & REC_FAT) { put_coded_v3(o, s->fat_box[i].lo, fat.lo); put_coded_v3(o, s->fat_box[i].hi, fat.hi); }
+        if (bits & REC_PREVIOUS) {
+            put_coded_v3(o, s->previous_origin[i], x.p);
+            put_coded_q(o, s->previous_rotation[i], x.q);
+        }
+    }
+}
+
+/* B's frame in A's (as collision.c computes it). */
+static xform relative_pose(xform xa, xform xb)
+{
+    xform r = {xf_inv_point(xa, xb.p), q_mul(q_conj(xa.q), xb.q)};
+    return r;
+}
+
+/* contact record bits, after the point count (3 bits) */
+enum { CREC_HAS_NORMAL = 8, CREC_FLIP = 16, CREC_SUB = 32, CREC_SUB_LIMIT = 64, CREC_FEATURE = 128, CREC_TANGENT = 256,
+       CREC_NORMAL = 512, CREC_CACHE_NORMAL = 1024, CREC_MATERIAL = 2048, CREC_POSE = 4096, CREC_REACH = 8192,
+       CREC_NORMAL_A = 16384, CREC_ALL = 32767 };
+
+/* A manifold normal is read while the pair touches, or touched last step (its
+ * end event); otherwise the next collision test rewrites it before anything
+ * reads it (collision.c), so it is not state and is not written. */
+static int normal_is_state(const contact *c, const contact_data *d)
+{
+    return d->m.count > 0 || (c->flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING));
+}
+
+/* What the reader predicts from the two bodies, before the contact's numbers. */
+typedef struct contact_guess {
+    xform xa, xb;
+    double friction, restitution;
+} contact_guess;
+
+static contact_guess guess_contact(const body_store *s, int a, int b)
+{
+    contact_guess g;
+    g.xa = body_xform(s, a);
+    g.xb = body_xform(s, b);
+    g.friction = sqrt(s->friction[a] * s->friction[b]);
+    g.restitution = dmax(s->restitution[a], s->restitution[b]);
+    return g;
+}
+
+static void write_contacts(writer *o, const carom_world *w)
 {
     const body_store *s = &w->bodies;
     const contact_set *cs = &w->contacts;
+    put_varint(o, (uint64_t)cs->count);
+    int last_a = 0;
+    for (int i = 0; i < cs->count; i++) {
+        const contact *c = &cs->items[i];
+        const contact_data *d = &cs->data[i];
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        contact_guess g = guess_contact(s, a, b);
+        /* what the reader will hold, and predict from */
+        vec3 normal = normal_is_state(c, d) ? d->m.normal : v3(0, 0, 0);
+        vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
+        int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
+        xform rel = relative_pose(g.xa, g.xb);
+        double reach = shape_bounding_radius(&s->shapes[b]);
+        vec3 normal_a = q_inv_rotate(g.xa.q, normal);
+        unsigned bits = (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
+                        (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
+                        (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
+                        (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
+                        (f64_bits(d->friction) == f64_bits(g.friction) && f64_bits(d->restitution) == f64_bits(g.restitution) &&
+                                    f64_bits(d->rolling_resistance) == 0
+                             ? 0 : CREC_MATERIAL) |
+                        (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
+                             ? CREC_POSE : 0) |
+                        ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
+                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, &normal_a, sizeof normal_a) ? CREC_NORMAL_A : 0);
+        put_varint(o, zigzag((int64_t)c->id_a - last_a));
+        put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
+        last_a = c->id_a;
+        put_u8(o, c->flags);
+        put_varint(o, bits);
+        if (bits & CREC_SUB) put_varint(o, c->sub);
+        if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
+        if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
+        if (bits & CREC_NORMAL) put_coded_v3(o, normal, v3(0, 0, 0));
+        if (bits & CREC_CACHE_NORMAL) put_coded_v3(o, c->cache.normal, cache_guess);
+        if (bits & CREC_MATERIAL) {
+            double v[3] = {d->friction, d->restitution, d->rolling_resistance}, p[3] = {g.friction, g.restitution, 0};
+            put_coded(o, v, p, 3);
+        }
+        if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, v3(0, 0, 0));
+        /* only what the collision stage reads under each flag (collision.c):
+         * the pose and gap of a pair known apart, the pose and normal of a
+         * manifold it may reuse */
+        if (bits & CREC_POSE) {
+            put_coded_v3(o, c->rel_pose.p, rel.p);
+            put_coded_q(o, c->rel_pose.q, rel.q);
+        }
+        if (c->flags & CONTACT_APART) put_coded1(o, c->gap, 0.0);
+        if (bits & CREC_REACH) put_coded1(o, c->reach_b, reach);
+        if (bits & CREC_NORMAL_A) put_coded_v3(o, d->normal_a, normal_a);
+        /* each point against the one before it (a manifold's points share
+         * their scale, most bits of their impulses, often all but a sign) */
+        double last[7] = {0, 0, 0, 0, 0, 0, 0};
+        for (int k = 0; k < d->m.count; k++) {
+            const manifold_point *p = &d->m.points[k];
+            const contact_point_state *st = &d->state[k];
+            double cur[7] = {st->local_a.x, st->local_a.y, st->local_a.z, st->separation,
+                             st->normal_impulse, st->tangent_impulse[0], st->tangent_impulse[1]};
+            put_varint(o, p->id);
+            put_coded(o, cur, last, 3);
+            put_coded_v3(o, p->point, xf_point(g.xa, st->local_a));
+            put_coded(o, cur + 3, last + 3, 4);
+            put_coded1(o, p->separation, st->separation);
+            memcpy(last, cur, sizeof cur);
+        }
+    }
+}
+
+static void write_world(writer *o, const carom_world *w, const class_table *t)
+{
+    const body_store *s = &w->bodies;
     write_def(o, &w->def);
     put_f64(o, 0.0); /* reserved: was the last step's dt (each step now carries its own) */
     put_u64(o, (uint64_t)w->stats.step_count);
 
-    put_i32(o, s->id_count);
-    put_i32(o, s->free_id);
+    put_varint(o, (uint64_t)s->id_count);
+    put_varint(o, (uint64_t)(s->free_id + 1));
     for (int i = 0; i < s->id_count; i++) {
-        put_i32(o, s->ids[i].slot);
-        put_u32(o, s->ids[i].generation);
-        put_i32(o, s->ids[i].next_free);
+        put_varint(o, zigzag((int64_t)s->ids[i].slot - i));
+        put_varint(o, s->ids[i].generation);
+        put_varint(o, (uint64_t)(s->ids[i].next_free + 1));
     }
-
-    put_i32(o, s->count);
-    for (int i = 0; i < s->count; i++) {
-        put_u8(o, (unsigned)s->type[i]);
-        put_u32(o, s->flags[i]);
-        put_u8(o, (unsigned)bp_is_moved(w->bp, s->proxy[i]));
-        put_v3(o, s->center[i]);
-        put_q(o, s->rotation[i]);
-        put_v3(o, s->velocity[i]);
-        put_v3(o, s->angular_velocity[i]);
-        put_v3(o, s->force[i]);
-        put_v3(o, s->local_center[i]);
-        put_f64(o, s->mass[i]);
-        put_m3(o, s->inertia_local[i]);
-        put_f64(o, s->friction[i]);
-        put_f64(o, s->restitution[i]);
-        put_f64(o, s->linear_damping[i]);
-        put_f64(o, s->angular_damping[i]);
-        put_f64(o, s->gravity_scale[i]);
-        put_v3(o, s->plane_normal[i]);
-        put_f64(o, s->plane_offset[i]);
-        put_f64(o, s->sleep_time[i]);
-        put_v3(o, s->fat_box[i].lo);
-        put_v3(o, s->fat_box[i].hi);
-        put_u64(o, s->category[i]);
-        put_u64(o, s->filter_mask[i]);
-        put_i32(o, s->group[i]);
-        put_v3(o, s->previous_origin[i]);
-        put_q(o, s->previous_rotation[i]);
-        put_v3(o, s->torque[i]);
-        put_f64(o, s->force_threshold[i]);
-        put_f64(o, s->rolling_resistance[i]);
-        put_u8(o, (unsigned)s->combine[i]);
-        write_shape(o, &s->shapes[i]);
-    }
-
-    put_i32(o, cs->count);
-    for (int i = 0; i < cs->count; i++) {
-        const contact *c = &cs->items[i];
-        const contact_data *d = &cs->data[i];
-        put_i32(o, c->id_a);
-        put_i32(o, c->id_b);
-        put_u32(o, c->flags);
-        put_u32(o, c->sub);
-        put_u32(o, c->sub_limit);
-        put_v3(o, c->cache.normal);
-        put_u8(o, (unsigned)c->cache.has_normal);
-        put_i32(o, c->cache.feature);
-        put_u8(o, (unsigned)c->cache.flip);
-        put_v3(o, c->rel_pose.p);
-        put_q(o, c->rel_pose.q);
-        put_f64(o, c->gap);
-        put_f64(o, c->reach_b);
-        put_f64(o, d->friction);
-        put_f64(o, d->restitution);
-        put_f64(o, d->rolling_resistance);
-        put_v3(o, d->m.normal);
-        put_u8(o, (unsigned)d->m.count);
-        for (int k = 0; k < d->m.count; k++) {
-            put_v3(o, d->m.points[k].point);
-            put_f64(o, d->m.points[k].separation);
-            put_u32(o, d->m.points[k].id);
-            put_f64(o, d->state[k].normal_impulse);
-            put_f64(o, d->state[k].tangent_impulse[0]);
-            put_f64(o, d->state[k].tangent_impulse[1]);
-            put_v3(o, d->state[k].local_a);
-            put_f64(o, d->state[k].separation);
-        }
-        put_v3(o, d->tangent1);
-        put_v3(o, d->normal_a);
-    }
+    write_bodies(o, w, t);
+    write_contacts(o, w);
     /* the sensors' overlaps after the last step (sensor.c): their next events */
-    put_i32(o, w->sensor_overlap_count);
+    put_varint(o, (uint64_t)w->sensor_overlap_count);
     for (int i = 0; i < w->sensor_overlap_count; i++) {
         put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].sensor));
         put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].other));
@@ -504,12 +1043,11 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
         world_fail(w, CAROM_ERROR_LOCKED, "world_snapshot: the world is inside its step; snapshot it afterwards");
         return 0;
     }
-    for (int i = 0; i < w->bodies.count; i++)
-        if (shape_is_composite(&w->bodies.shapes[i])) {
-            /* their format is still to be written (docs/snapshot.md): refuse rather than lose them */
-            world_fail(w, CAROM_ERROR_UNSUPPORTED, "world_snapshot: meshes, height fields and compounds are not in snapshots yet");
-            return 0;
-        }
+    class_table t;
+    if (!build_classes(&w->bodies, &t)) {
+        world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "world_snapshot: out of memory");
+        return 0;
+    }
     if (!buf) capacity = 0;
     writer o = {buf, capacity, 0};
     put_bytes(&o, SNAP_MAGIC, 8);
@@ -517,7 +1055,8 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
     put_u32(&o, SNAP_HEADER_SIZE);
     put_u64(&o, 0); /* total size, filled below */
     put_u64(&o, 0); /* checksum, filled below */
-    write_world(&o, w);
+    write_world(&o, w, &t);
+    class_table_free(&t);
     if (o.pos <= capacity) {
         writer h = {buf, capacity, 16};
         put_u64(&h, (uint64_t)o.pos);
@@ -526,148 +1065,241 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
     return o.pos;
 }
 
-/* Body fields, read into the store of a world just created from the def. */
-static int read_bodies(reader *r, carom_world *w)
+/* ---- reading it back ------------------------------------------------------------------ */
+
+typedef struct body_class {
+    int type;
+    uint32_t flags;
+    vec3 local_center, plane_normal;
+    double mass, friction, restitution, linear_damping, angular_damping, gravity_scale;
+    mat3 inertia;
+    uint64_t category, mask;
+    int group, combine;
+    double force_threshold, rolling_resistance;
+    size_t shape_at;        /* where its shape starts in the snapshot */
+} body_class;
+
+/* One class, checked as the API checks a body def; its shape is read (and
+ * checked) here and again, from shape_at, for every body of the class. */
+static int read_class(reader *r, body_class *k)
 {
-    body_store *s = &w->bodies;
-    int id_count = get_count(r, 12, 1 << 26, "id count");
-    int free_id = get_i32(r, "free id");
+    k->type = (int)get_u8(r, "class type");
+    k->flags = get_u32(r, "class flags");
+    k->local_center = get_v3(r, "class centre of mass");
+    k->mass = get_f64(r, "class mass");
+    k->inertia = get_m3(r, "class inertia");
+    k->friction = get_f64(r, "class friction");
+    k->restitution = get_f64(r, "class restitution");
+    k->linear_damping = get_f64(r, "class damping");
+    k->angular_damping = get_f64(r, "class damping");
+    k->gravity_scale = get_f64(r, "class gravity scale");
+    k->plane_normal = get_v3(r, "class plane normal");
+    k->category = get_u64(r, "class filter");
+    k->mask = get_u64(r, "class filter");
+    k->group = get_i32(r, "class filter");
+    k->force_threshold = get_f64(r, "class force threshold");
+    k->rolling_resistance = get_f64(r, "class rolling resistance");
+    k->combine = (int)get_u8(r, "class combine mode");
     if (r->failed) return 0;
-    /* read into the store's own id table, so the world frees it on any failure */
+    if (!(k->force_threshold >= 0 && k->rolling_resistance >= 0 && k->rolling_resistance <= RANGE_FRICTION_MAX &&
+          k->combine <= CAROM_COMBINE_MAX))
+        return bad(r, "a body class's force threshold, rolling resistance or combine mode is out of range");
+    int type = k->type;
+    if (type != CAROM_BODY_STATIC && type != CAROM_BODY_KINEMATIC && type != CAROM_BODY_DYNAMIC)
+        return bad(r, "a body class has type %d", type);
+    if (k->flags & ~(uint32_t)(BODY_KNOWN_FLAGS & ~BODY_STATE_FLAGS)) return bad(r, "a body class has unknown flags");
+    if (!(fabs(k->local_center.x) <= RANGE_LENGTH_MAX && fabs(k->local_center.y) <= RANGE_LENGTH_MAX &&
+          fabs(k->local_center.z) <= RANGE_LENGTH_MAX))
+        return bad(r, "a body class's centre of mass is beyond 1e6 m");
+    if (type == CAROM_BODY_DYNAMIC) {
+        mat3 I = k->inertia;
+        double trace = I.c0.x + I.c1.y + I.c2.z;
+        if (!(k->mass >= RANGE_MASS_MIN && k->mass <= RANGE_MASS_MAX))
+            return bad(r, "a body class's mass %g is outside [1e-9, 1e15] kg", k->mass);
+        if (!(trace <= RANGE_INERTIA_MAX && m3_det(I) / (trace * trace) >= RANGE_INERTIA_MIN))
+            return bad(r, "a body class's inertia is outside [1e-24, 1e30] kg m^2");
+    }
+    if (!(k->mass >= 0) ||
+        !(k->friction >= 0 && k->friction <= RANGE_FRICTION_MAX && k->restitution >= 0 && k->restitution <= 1 &&
+          k->linear_damping >= 0 && k->linear_damping <= RANGE_DAMPING_MAX && k->angular_damping >= 0 &&
+          k->angular_damping <= RANGE_DAMPING_MAX && fabs(k->gravity_scale) <= RANGE_GRAVITY_SCALE_MAX))
+        return bad(r, "a body class's mass, material, damping or gravity scale is out of range");
+    if ((k->flags & BODY_LOCK_PLANE) && fabs(v3_len(k->plane_normal) - 1.0) > 1e-9)
+        return bad(r, "a body class's plane normal is not unit");
+    k->shape_at = r->pos;
+    shape sh;
+    int ok = read_shape(r, &sh, type, 0);
+    shape_free_data(&sh);
+    return ok;
+}
+
+/* The id table, read into the store of a world just created from the def. */
+static int read_ids(reader *r, body_store *s)
+{
+    int id_count = get_small(r, 0, 1 << 26, 0, "id count");
+    int free_id = get_small(r, 0, id_count, 0, "free id") - 1;
+    if (r->failed) return 0;
+    if ((size_t)id_count * 3 > r->size - r->pos) return bad(r, "truncated: %d ids need more than the bytes left", id_count);
     body_id_entry *ids = malloc(sizeof *ids * (size_t)(id_count > 0 ? id_count : 1));
     if (!ids) return bad(r, "out of memory");
     free(s->ids);
     s->ids = ids;
     s->id_capacity = id_count > 0 ? id_count : 1;
     s->id_count = 0;
-    for (int i = 0; i < id_count; i++) {
-        ids[i].slot = get_i32(r, "id slot");
-        ids[i].generation = get_u32(r, "id generation");
-        ids[i].next_free = get_i32(r, "id free link");
+    s->free_id = -1;
+    for (int i = 0; i < id_count && !r->failed; i++) {
+        ids[i].slot = i + get_small(r, -1 - (int64_t)i, (int64_t)id_count - i, 1, "id slot");
+        ids[i].generation = (uint32_t)get_small(r, 0, UINT32_MAX, 0, "id generation");
+        ids[i].next_free = get_small(r, 0, id_count, 0, "id free link") - 1;
     }
-    /* bodies: at least 300 bytes each */
-    int count = get_count(r, 300, id_count, "body count");
     if (r->failed) return 0;
-    if (free_id < -1 || free_id >= id_count) return bad(r, "free id %d out of range", free_id);
-    /* every live id names a distinct slot below count; the free list visits every free id once */
+    s->id_count = id_count;
+    s->free_id = free_id;
+    return 1;
+}
+
+/* Every live id names a distinct slot below count; the free list visits every free id once. */
+static int check_ids(reader *r, body_store *s, int count)
+{
+    const body_id_entry *ids = s->ids;
     int live = 0, free_ids = 0;
-    for (int i = 0; i < id_count; i++) {
+    for (int i = 0; i < s->id_count; i++) {
         if (ids[i].slot < -1 || ids[i].slot >= count) return bad(r, "id %d has slot %d of %d", i, ids[i].slot, count);
-        if (ids[i].next_free < -1 || ids[i].next_free >= id_count) return bad(r, "id %d free link out of range", i);
         if (ids[i].slot >= 0) live++;
         else free_ids++;
     }
     if (live != count) return bad(r, "%d live ids for %d bodies", live, count);
     int walked = 0;
-    for (int f = free_id; f >= 0; f = ids[f].next_free)
+    for (int f = s->free_id; f >= 0; f = ids[f].next_free)
         if (ids[f].slot >= 0 || ++walked > free_ids) return bad(r, "the free id list is corrupt");
     if (walked != free_ids) return bad(r, "the free id list misses ids");
-    /* the dense arrays, sized for the bodies (the id table is kept aside meanwhile) */
-    s->ids = NULL;
-    body_store_free(s);
-    int ok = body_store_init(s, count);
-    s->ids = ids;
-    s->id_capacity = id_count > 0 ? id_count : 1;
-    s->id_count = id_count;
-    s->free_id = free_id;
-    if (!ok) return bad(r, "out of memory");
     for (int i = 0; i < count; i++) s->id_index[i] = -1;
-    for (int i = 0; i < id_count; i++)
+    for (int i = 0; i < s->id_count; i++)
         if (ids[i].slot >= 0) {
             if (s->id_index[ids[i].slot] >= 0) return bad(r, "two ids share slot %d", ids[i].slot);
             s->id_index[ids[i].slot] = i;
         }
+    return 1;
+}
+
+static int read_bodies(reader *r, carom_world *w)
+{
+    body_store *s = &w->bodies;
+    if (!read_ids(r, s)) return 0;
+    int class_count = get_small(r, 0, 1 << 26, 0, "class count");
+    if (r->failed) return 0;
+    if ((size_t)class_count * 200 > r->size - r->pos) return bad(r, "truncated: %d body classes", class_count);
+    body_class *classes = malloc(sizeof *classes * (size_t)(class_count > 0 ? class_count : 1));
+    if (!classes) return bad(r, "out of memory");
+    for (int k = 0; k < class_count; k++)
+        if (!read_class(r, &classes[k])) { free(classes); return 0; }
+    int count = get_small(r, 0, s->id_count, 0, "body count");
+    if (r->failed || (size_t)count * 60 > r->size - r->pos) {
+        free(classes);
+        return r->failed ? 0 : bad(r, "truncated: %d bodies need more than the bytes left", count);
+    }
+    /* the dense arrays, sized for the bodies (the id table is kept aside meanwhile) */
+    body_id_entry *ids = s->ids;
+    int id_count = s->id_count, free_id = s->free_id, id_capacity = s->id_capacity;
+    s->ids = NULL;
+    body_store_free(s);
+    int ok = body_store_init(s, count);
+    free(s->ids);
+    s->ids = ids;
+    s->id_capacity = id_capacity;
+    s->id_count = id_count;
+    s->free_id = free_id;
+    if (!ok) { free(classes); return bad(r, "out of memory"); }
+    if (!check_ids(r, s, count)) { free(classes); return 0; }
+    vec3 last_center = v3(0, 0, 0);
+    quat last_rotation = {1, 0, 0, 0};
+    double last_sleep = 0;
     for (int i = 0; i < count; i++) {
         char what[48];
         snprintf(what, sizeof what, "body %d", i);
-        int type = (int)get_u8(r, what);
-        uint32_t flags = get_u32(r, what);
-        int moved = (int)get_u8(r, what);
-        if (r->failed) return 0;
-        if (type != CAROM_BODY_STATIC && type != CAROM_BODY_KINEMATIC && type != CAROM_BODY_DYNAMIC)
-            return bad(r, "body %d has type %d", i, type);
-        if ((flags & ~(uint32_t)BODY_KNOWN_FLAGS) || moved > 1) return bad(r, "body %d has unknown flags", i);
-        if (type == CAROM_BODY_STATIC && (flags & BODY_AWAKE)) return bad(r, "static body %d is awake", i);
-        s->type[i] = type;
-        s->flags[i] = flags;
-        s->solver_index[i] = moved; /* held here until the proxies exist */
-        s->center[i] = get_v3(r, what);
-        s->rotation[i] = get_q(r, what);
-        s->velocity[i] = get_v3(r, what);
-        s->angular_velocity[i] = get_v3(r, what);
-        s->force[i] = get_v3(r, what);
-        s->local_center[i] = get_v3(r, what);
-        s->mass[i] = get_f64(r, what);
-        s->inertia_local[i] = get_m3(r, what);
-        s->friction[i] = get_f64(r, what);
-        s->restitution[i] = get_f64(r, what);
-        s->linear_damping[i] = get_f64(r, what);
-        s->angular_damping[i] = get_f64(r, what);
-        s->gravity_scale[i] = get_f64(r, what);
-        s->plane_normal[i] = get_v3(r, what);
-        s->plane_offset[i] = get_f64(r, what);
-        s->sleep_time[i] = get_f64(r, what);
-        s->fat_box[i].lo = get_v3(r, what);
-        s->fat_box[i].hi = get_v3(r, what);
-        s->category[i] = get_u64(r, what);
-        s->filter_mask[i] = get_u64(r, what);
-        s->group[i] = get_i32(r, what);
-        s->previous_origin[i] = get_v3(r, what);
-        s->previous_rotation[i] = get_q(r, what);
-        s->torque[i] = get_v3(r, what);
-        s->force_threshold[i] = get_f64(r, what);
-        s->rolling_resistance[i] = get_f64(r, what);
-        s->combine[i] = (int)get_u8(r, what);
+        int bits = get_small(r, 0, 1023, 0, what);
+        int ci = get_small(r, 0, class_count - 1, 0, what);
+        if (r->failed) break;
+        const body_class *k = &classes[ci];
+        if (k->type == CAROM_BODY_STATIC && (bits & REC_AWAKE)) { bad(r, "static body %d is awake", i); break; }
+        s->type[i] = k->type;
+        s->flags[i] = k->flags | ((bits & REC_AWAKE) ? BODY_AWAKE : 0) | ((bits & REC_FORCE_FLAG) ? BODY_HAS_FORCE : 0);
+        s->solver_index[i] = (bits & REC_MOVED) != 0; /* held here until the proxies exist */
+        s->local_center[i] = k->local_center;
+        s->mass[i] = k->mass;
+        s->inertia_local[i] = k->inertia;
+        s->friction[i] = k->friction;
+        s->restitution[i] = k->restitution;
+        s->linear_damping[i] = k->linear_damping;
+        s->angular_damping[i] = k->angular_damping;
+        s->gravity_scale[i] = k->gravity_scale;
+        s->plane_normal[i] = k->plane_normal;
+        s->category[i] = k->category;
+        s->filter_mask[i] = k->mask;
+        s->group[i] = k->group;
+        s->force_threshold[i] = k->force_threshold;
+        s->rolling_resistance[i] = k->rolling_resistance;
+        s->combine[i] = k->combine;
         s->user_data[i] = NULL;
         s->proxy[i] = -1;
-        if (r->failed) return 0;
-        s->count = i; /* the shapes of bodies 0..i-1 are owned: freed if a later one fails */
-        if (!read_shape(r, &s->shapes[i], type)) return 0;
-        s->count = i + 1;
-        int dynamic = type == CAROM_BODY_DYNAMIC;
+        s->center[i] = last_center = get_coded_v3(r, last_center, what);
+        s->rotation[i] = last_rotation = get_coded_q(r, last_rotation, what);
+        s->velocity[i] = (bits & REC_VELOCITY) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
+        s->angular_velocity[i] = (bits & REC_SPIN) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
+        s->force[i] = (bits & REC_FORCE) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
+        s->torque[i] = (bits & REC_TORQUE) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
+        s->sleep_time[i] = (bits & REC_SLEEP_TIME) ? (last_sleep = get_coded1(r, last_sleep, what)) : 0.0;
+        s->plane_offset[i] = (k->flags & BODY_LOCK_PLANE) ? get_coded1(r, v3_dot(k->plane_normal, s->center[i]), what) : 0.0;
+        if (r->failed) break;
+        if (!(fabs(s->center[i].x) <= RANGE_COORDINATE_MAX && fabs(s->center[i].y) <= RANGE_COORDINATE_MAX &&
+              fabs(s->center[i].z) <= RANGE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e12 m", i); break; }
         quat q = s->rotation[i];
-        double ql = sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-        if (fabs(ql - 1.0) > 1e-6) return bad(r, "body %d orientation is not unit", i);
-        if (type == CAROM_BODY_DYNAMIC) {
-            mat3 I = s->inertia_local[i];
-            double trace = I.c0.x + I.c1.y + I.c2.z;
-            if (!(s->mass[i] >= RANGE_MASS_MIN && s->mass[i] <= RANGE_MASS_MAX))
-                return bad(r, "body %d mass %g is outside [1e-9, 1e15] kg", i, s->mass[i]);
-            if (!(trace <= RANGE_INERTIA_MAX && m3_det(I) / (trace * trace) >= RANGE_INERTIA_MIN))
-                return bad(r, "body %d inertia is outside [1e-24, 1e30] kg m^2", i);
+        if (fabs(sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) > 1e-6) { bad(r, "body %d orientation is not unit", i); break; }
+        if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX)) {
+            bad(r, "body %d moves faster than any world allows", i);
+            break;
         }
-        if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX))
-            return bad(r, "body %d moves faster than any world allows", i);
         /* the force bound is the API's loosest (apply_force checks it against
          * the mass then; set_mass may lower the mass later) */
-        if (!(s->mass[i] >= 0) || !(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX))
-            return bad(r, "body %d mass or force out of range", i);
-        if (!(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX && isfinite(s->force_threshold[i]) &&
-              s->force_threshold[i] >= 0 && s->rolling_resistance[i] >= 0 &&
-              s->rolling_resistance[i] <= RANGE_FRICTION_MAX && s->combine[i] <= CAROM_COMBINE_MAX))
-            return bad(r, "body %d torque, force threshold, rolling resistance or combine mode out of range", i);
-        if (!(s->friction[i] >= 0 && s->friction[i] <= RANGE_FRICTION_MAX && s->restitution[i] >= 0 &&
-              s->restitution[i] <= 1 && s->linear_damping[i] >= 0 && s->linear_damping[i] <= RANGE_DAMPING_MAX &&
-              s->angular_damping[i] >= 0 && s->angular_damping[i] <= RANGE_DAMPING_MAX &&
-              fabs(s->gravity_scale[i]) <= RANGE_GRAVITY_SCALE_MAX && s->sleep_time[i] >= 0))
-            return bad(r, "body %d material, damping, gravity scale or sleep timer out of range", i);
-        if ((flags & BODY_LOCK_PLANE) && fabs(v3_len(s->plane_normal[i]) - 1.0) > 1e-9)
-            return bad(r, "body %d plane normal is not unit", i);
-        aabb b = s->fat_box[i];
-        if (!(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return bad(r, "body %d bounds are inverted", i);
+        if (!(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX) || !(s->sleep_time[i] >= 0) ||
+            !(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX) ||
+            !(fabs(s->plane_offset[i]) <= RANGE_COORDINATE_MAX)) {
+            bad(r, "body %d force, sleep timer or plane offset out of range", i);
+            break;
+        }
+        /* the shape, again from its class (each body owns its copy) */
+        reader sr = *r;
+        sr.pos = k->shape_at;
+        s->count = i; /* the shapes of bodies 0..i-1 are owned: freed if a later one fails */
+        if (!read_shape(&sr, &s->shapes[i], k->type, 0)) { r->failed = 1; break; }
+        s->count = i + 1;
+        xform x = body_xform(s, i);
+        aabb fat = predicted_fat_box(w, i);
+        if (bits & REC_FAT) {
+            fat.lo = get_coded_v3(r, fat.lo, what);
+            fat.hi = get_coded_v3(r, fat.hi, what);
+        }
+        s->fat_box[i] = fat;
+        s->previous_origin[i] = (bits & REC_PREVIOUS) ? get_coded_v3(r, x.p, what) : x.p;
+        s->previous_rotation[i] = (bits & REC_PREVIOUS) ? get_coded_q(r, x.q, what) : x.q;
+        if (r->failed) break;
+        if (!(fat.lo.x <= fat.hi.x && fat.lo.y <= fat.hi.y && fat.lo.z <= fat.hi.z)) { bad(r, "body %d bounds are inverted", i); break; }
         /* derived fields, computed as body creation and the setters compute them */
+        int dynamic = k->type == CAROM_BODY_DYNAMIC;
         s->inv_mass[i] = dynamic ? 1.0 / s->mass[i] : 0.0;
         s->inv_inertia_local[i] = dynamic ? m3_inverse(s->inertia_local[i]) : m3_zero();
         body_update_inertia(s, i);
     }
-    return 1;
+    free(classes);
+    return !r->failed;
 }
 
 /* (sensor.c's pairs: a sensor id and another, two packed ids each) */
 static int read_sensor_overlaps(reader *r, carom_world *w)
 {
-    int count = get_count(r, 16, 1 << 28, "sensor overlap count");
+    int count = get_small(r, 0, 1 << 28, 0, "sensor overlap count");
     if (r->failed) return 0;
+    if ((size_t)count * 16 > r->size - r->pos) return bad(r, "truncated: %d sensor overlaps", count);
     if (count == 0) return 1;
     sensor_overlap *pairs = malloc(sizeof *pairs * (size_t)count);
     if (!pairs) return bad(r, "out of memory");
@@ -690,55 +1322,91 @@ static int read_contacts(reader *r, carom_world *w)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
-    int count = get_count(r, 188, 1 << 28, "contact count");
+    int count = get_small(r, 0, 1 << 28, 0, "contact count");
+    if (r->failed) return 0;
+    if ((size_t)count * 4 > r->size - r->pos) return bad(r, "truncated: %d contacts need more than the bytes left", count);
+    if (!contact_set_reserve(cs, count)) return bad(r, "out of memory");
+    int last_a = 0;
     for (int i = 0; i < count && !r->failed; i++) {
-        int a = get_i32(r, "contact body"), b = get_i32(r, "contact body");
+        int a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 2 - last_a, 1, "contact body");
         if (r->failed) return 0;
-        if (a < 0 || b >= s->id_count || a >= b || s->ids[a].slot < 0 || s->ids[b].slot < 0)
-            return bad(r, "contact %d joins ids %d and %d, not two live bodies in order", i, a, b);
-        uint32_t flags = get_u32(r, "contact flags"), sub = get_u32(r, "contact sub");
+        int b = a + 1 + get_small(r, 0, (int64_t)s->id_count - 2 - a, 0, "contact body");
         if (r->failed) return 0;
-        if (sub > 1000000) return bad(r, "contact %d has manifold number %u", i, (unsigned)sub);
+        last_a = a;
+        if (s->ids[a].slot < 0 || s->ids[b].slot < 0)
+            return bad(r, "contact %d joins ids %d and %d, not two live bodies", i, a, b);
+        uint32_t flags = get_u8(r, "contact flags");
+        int bits = get_small(r, 0, CREC_ALL, 0, "contact bits");
+        uint32_t sub = (bits & CREC_SUB) ? (uint32_t)get_small(r, 1, 1000000, 0, "contact sub") : 0;
+        uint32_t sub_limit = (bits & CREC_SUB_LIMIT) ? (uint32_t)get_small(r, 1, 1000001, 0, "contact sub limit") : 0;
+        int feature = (bits & CREC_FEATURE) ? get_small(r, 0, INT32_MAX, 1, "contact cache feature") : -1;
+        if (r->failed) return 0;
+        int posed = (flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
+        if ((flags & ~(uint32_t)CONTACT_KNOWN_FLAGS) || (bits & 7) > MANIFOLD_MAX_POINTS || (bits & CREC_FEATURE && feature == -1) ||
+            ((bits & CREC_POSE) && !posed) || ((bits & CREC_REACH) && !(flags & CONTACT_APART)) ||
+            ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
+            return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
         if ((sub ? contact_find_sub(cs, a, b, sub) : contact_find(cs, a, b)) >= 0)
             return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", i, a, b, (unsigned)sub);
         int ci = sub ? contact_add_sub(cs, a, b, sub) : contact_add(cs, a, b);
         if (ci < 0) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];
+        int sa = s->ids[a].slot, sb = s->ids[b].slot;
+        contact_guess g = guess_contact(s, sa, sb);
         c->flags = flags;
-        c->sub_limit = get_u32(r, "contact sub limit");
-        c->cache.normal = get_v3(r, "contact cache normal");
-        c->cache.has_normal = (int)get_u8(r, "contact cache");
-        c->cache.feature = get_i32(r, "contact cache feature");
-        c->cache.flip = (int)get_u8(r, "contact cache");
-        c->rel_pose.p = get_v3(r, "contact pose");
-        c->rel_pose.q = get_q(r, "contact pose");
-        c->gap = get_f64(r, "contact gap");
-        c->reach_b = get_f64(r, "contact reach");
-        d->friction = get_f64(r, "contact friction");
-        d->restitution = get_f64(r, "contact restitution");
-        d->rolling_resistance = get_f64(r, "contact rolling resistance");
-        d->m.normal = get_v3(r, "manifold normal");
-        d->m.count = (int)get_u8(r, "manifold count");
+        c->sub_limit = sub_limit;
+        c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
+        c->cache.flip = (bits & CREC_FLIP) != 0;
+        c->cache.feature = feature;
+        d->m.count = bits & 7;
+        vec3 normal = (bits & CREC_NORMAL) ? get_coded_v3(r, v3(0, 0, 0), "manifold normal") : v3(0, 0, 0);
+        d->m.normal = normal;
+        if (!r->failed && !v3_is_zero(normal) && !normal_is_state(c, d))
+            return bad(r, "contact %d has a normal it does not use", i);
+        vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
+        c->cache.normal = (bits & CREC_CACHE_NORMAL) ? get_coded_v3(r, cache_guess, "contact cache normal") : cache_guess;
+        double material[3] = {g.friction, g.restitution, 0}, guess[3] = {g.friction, g.restitution, 0};
+        if (bits & CREC_MATERIAL) get_coded(r, material, guess, 3, "contact material");
+        d->friction = material[0];
+        d->restitution = material[1];
+        d->rolling_resistance = material[2];
+        d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, v3(0, 0, 0), "friction basis") : v3(0, 0, 0);
+        if (posed) {
+            xform rel = relative_pose(g.xa, g.xb);
+            c->rel_pose.p = (bits & CREC_POSE) ? get_coded_v3(r, rel.p, "contact pose") : rel.p;
+            c->rel_pose.q = (bits & CREC_POSE) ? get_coded_q(r, rel.q, "contact pose") : rel.q;
+        }
+        if (flags & CONTACT_APART) {
+            double reach = shape_bounding_radius(&s->shapes[sb]);
+            c->gap = get_coded1(r, 0.0, "contact gap");
+            c->reach_b = (bits & CREC_REACH) ? get_coded1(r, reach, "contact reach") : reach;
+        }
+        if (flags & CONTACT_REUSABLE) {
+            vec3 normal_a = q_inv_rotate(g.xa.q, normal);
+            d->normal_a = (bits & CREC_NORMAL_A) ? get_coded_v3(r, normal_a, "contact normal") : normal_a;
+        }
         if (r->failed) return 0;
-        if ((c->flags & ~(uint32_t)CONTACT_KNOWN_FLAGS) || c->cache.has_normal > 1 || c->cache.flip > 1 ||
-            c->cache.feature < -1 || d->m.count > MANIFOLD_MAX_POINTS)
-            return bad(r, "contact %d has unknown flags or a bad cache", i);
         if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
               d->rolling_resistance >= 0 && d->rolling_resistance <= RANGE_FRICTION_MAX))
             return bad(r, "contact %d material out of range", i);
-        for (int k = 0; k < d->m.count; k++) {
-            d->m.points[k].point = get_v3(r, "manifold point");
-            d->m.points[k].separation = get_f64(r, "manifold point");
-            d->m.points[k].id = get_u32(r, "manifold point");
-            d->state[k].normal_impulse = get_f64(r, "warm-start impulse");
-            d->state[k].tangent_impulse[0] = get_f64(r, "warm-start impulse");
-            d->state[k].tangent_impulse[1] = get_f64(r, "warm-start impulse");
-            d->state[k].local_a = get_v3(r, "contact point");
-            d->state[k].separation = get_f64(r, "contact point");
+        double last[7] = {0, 0, 0, 0, 0, 0, 0};
+        for (int k = 0; k < d->m.count && !r->failed; k++) {
+            manifold_point *p = &d->m.points[k];
+            contact_point_state *st = &d->state[k];
+            double cur[7];
+            p->id = (uint32_t)get_small(r, 0, UINT32_MAX, 0, "manifold point id");
+            get_coded(r, cur, last, 3, "contact point");
+            st->local_a = v3(cur[0], cur[1], cur[2]);
+            p->point = get_coded_v3(r, xf_point(g.xa, st->local_a), "manifold point");
+            get_coded(r, cur + 3, last + 3, 4, "contact point");
+            st->separation = cur[3];
+            st->normal_impulse = cur[4];
+            st->tangent_impulse[0] = cur[5];
+            st->tangent_impulse[1] = cur[6];
+            p->separation = get_coded1(r, st->separation, "manifold point");
+            memcpy(last, cur, sizeof cur);
         }
-        d->tangent1 = get_v3(r, "friction basis");
-        d->normal_a = get_v3(r, "contact normal");
     }
     return !r->failed;
 }

@@ -102,6 +102,56 @@ static carom_world *mixed_scene(const char *preset, int *event_count)
     k.linear_velocity = vec(0.8, 0, 0);
     k.angular_velocity = vec(0, 0, 0.3);
     carom_body_create(w, &k);
+    /* every composite shape: a static mesh ramp, a kinematic height field
+     * with a hole, compounds landing on both (the mesh and field are
+     * written whole, their trees and triangle order kept) */
+    static const double ramp_v[] = {2, -3, 0.05, 2.5, -3, 0.05, 2.5, -1.5, 0.4, 2, -1.5, 0.4, 2.25, -2.2, 0.3};
+    static const int ramp_t[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+    carom_mesh_def md = carom_mesh_def_default();
+    md.vertices = ramp_v;
+    md.vertex_count = 5;
+    md.triangles = ramp_t;
+    md.triangle_count = 4;
+    carom_body_def mb = carom_body_def_default();
+    mb.type = CAROM_BODY_STATIC;
+    mb.shape.type = CAROM_SHAPE_MESH;
+    mb.mesh = &md;
+    assert_false(carom_body_id_is_null(carom_body_create(w, &mb)));
+    static double heights[5 * 6];
+    for (int i = 0; i < 30; i++) heights[i] = 0.02 * (i % 6) + 0.03 * (i / 6) - 0.1;
+    static const int holes[] = {7};
+    carom_heightfield_def hd = carom_heightfield_def_default();
+    hd.heights = heights;
+    hd.rows = 5;
+    hd.columns = 6;
+    hd.cell_x = 0.3;
+    hd.cell_y = 0.25;
+    hd.holes = holes;
+    hd.hole_count = 1;
+    carom_body_def hb = carom_body_def_default();
+    hb.type = CAROM_BODY_KINEMATIC;
+    hb.shape.type = CAROM_SHAPE_HEIGHTFIELD;
+    hb.heightfield = &hd;
+    hb.position = vec(-2.5, 2.5, 0.05);
+    hb.angular_velocity = vec(0, 0, 0.05);
+    assert_false(carom_body_id_is_null(carom_body_create(w, &hb)));
+    carom_compound_child kids[3] = {carom_compound_child_default(carom_shape_box(0.15, 0.1, 0.05)),
+                                    carom_compound_child_default(carom_shape_sphere(0.08)),
+                                    carom_compound_child_default(carom_shape_hull(tetra, 5))};
+    kids[1].position = vec(0.2, 0, 0.05);
+    kids[1].friction = 0.9;
+    kids[1].restitution = 0.4;
+    kids[2].position = vec(-0.2, 0.05, 0);
+    kids[2].density = 3000;
+    for (int i = 0; i < 3; i++) {
+        carom_body_def cb = carom_body_def_default();
+        cb.shape.type = CAROM_SHAPE_COMPOUND;
+        cb.children = kids;
+        cb.child_count = 3;
+        cb.position = i < 2 ? vec(2.25, -2.6 + 0.7 * i, 0.9) : vec(-2.4, 2.6, 0.6);
+        cb.angular_velocity = vec(0.2 * i, 0.4, 0);
+        assert_false(carom_body_id_is_null(carom_body_create(w, &cb)));
+    }
     /* a fast bullet at the wall */
     carom_body_def f = carom_body_def_default();
     f.shape = carom_shape_sphere(0.05);
@@ -233,9 +283,12 @@ static void test_bad_snapshots_refused(void **state)
     /* wrong version, foreign data */
     unsigned char *copy = malloc(s.size);
     memcpy(copy, s.data, s.size);
-    copy[8] = 2;
+    copy[8] = 1; /* the format before this one */
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
-    assert_non_null(strstr(msg, "version 2"));
+    assert_non_null(strstr(msg, "version 1"));
+    copy[8] = 3;
+    assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
+    assert_non_null(strstr(msg, "version 3"));
     memcpy(copy, "PNG\r\n\x1a\n\0", 8);
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
     assert_non_null(strstr(msg, "not a carom snapshot"));
