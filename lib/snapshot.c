@@ -1194,7 +1194,7 @@ static int read_bodies(reader *r, carom_world *w)
     for (int k = 0; k < class_count; k++)
         if (!read_class(r, &classes[k])) { free(classes); return 0; }
     int count = get_small(r, 0, s->id_count, 0, "body count");
-    if (r->failed || (size_t)count * 60 > r->size - r->pos) {
+    if (r->failed || (size_t)count * 6 > r->size - r->pos) { /* the shortest body record */
         free(classes);
         return r->failed ? 0 : bad(r, "truncated: %d bodies need more than the bytes left", count);
     }
