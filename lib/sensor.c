@@ -146,7 +146,8 @@ int world_update_sensors(carom_world *w)
         int c = i >= n_old ? 1 : j >= q.count ? -1 : compare_overlaps(&old[i], &q.found[j]);
         if (c == 0) { i++; j++; continue; }
         if (c < 0) {
-            if (carom_body_is_valid(w, old[i].sensor)) push_sensor_event(w, CAROM_EVENT_SENSOR_END, &old[i]);
+            if (body_store_slot(&w->bodies, old[i].sensor.index1, old[i].sensor.generation) >= 0)
+                push_sensor_event(w, CAROM_EVENT_SENSOR_END, &old[i]);
             i++;
         } else {
             push_sensor_event(w, CAROM_EVENT_SENSOR_BEGIN, &q.found[j]);
