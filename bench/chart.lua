@@ -4,7 +4,7 @@
 -- pixels, where they overlap neither each other nor a point.
 local M = {}
 
-local W, H = 1040, 600                    -- canvas, px
+local W, H = 1180, 600                    -- canvas, px
 local PL, PR, PT, PB = 110, 700, 60, 530  -- plot area, px from the top left
 local FONT, CHAR_W, LINE_H = 12, 7.6, 16  -- Sans 12 at pngcairo's 72 dpi (approx.)
 M.plot_right = PR
@@ -21,6 +21,11 @@ function M.log_ticks(lo, hi)
         local v = m * 10 ^ e
         if v >= lo * (1 - 1e-9) and v <= hi * (1 + 1e-9) then t[#t + 1] = v end
       end
+    end
+    if #t > 9 then -- many decades: every k-th one, at most nine ticks
+      local k, thin = math.ceil(#t / 9), {}
+      for i = 1, #t, k do thin[#thin + 1] = t[i] end
+      t = thin
     end
     if #t >= 3 then return t end
   end
@@ -67,29 +72,44 @@ local function place(chart)
       last = { x, y }
     end
   end
-  local placed = {}
-  for _, l in ipairs(chart.labels) do
-    local x, y = to_px(chart.x, l.x, PL, PR), to_px(chart.y, l.y, PB, PT)
-    local w, h = #l.text * CHAR_W, LINE_H
-    local spot
-    for _, d in ipairs{ 8, 20, 34, 50, 70, 95, 125, 160 } do
-      for _, c in ipairs{ { d, -h - 2 }, { d, 2 }, { -w - d, -h - 2 }, { -w - d, 2 },
-                          { -w / 2, -h - d }, { -w / 2, d }, { d, -h / 2 }, { -w - d, -h / 2 } } do
+  -- the first clear box for text near (x, y), no farther than the last distance
+  local function find_spot(x, y, text, distances)
+    local w, h = #text * CHAR_W, LINE_H
+    for _, d in ipairs(distances) do
+      for _, c in ipairs{ { d, -h / 2 }, { -w - d, -h / 2 }, { d, -h - 2 }, { d, 2 }, { -w - d, -h - 2 },
+                          { -w - d, 2 }, { -w / 2, -h - d }, { -w / 2, d } } do
         local b = { x + c[1], y + c[2], x + c[1] + w, y + c[2] + h }
-        if clear(b) then spot = b; break end
+        if clear(b) then return b end
       end
-      if spot then break end
-    end
-    if spot then
-      boxes[#boxes + 1] = spot
-      -- a leader from the point to the nearest edge of its label, when that is far
-      local ex, ey = math.max(spot[1], math.min(x, spot[3])), math.max(spot[2], math.min(y, spot[4]))
-      placed[#placed + 1] = { text = l.text, color = l.color, left = spot[1], middle = (spot[2] + spot[4]) / 2,
-                              leader = { x, y, ex, ey }, near = (ex - x) ^ 2 + (ey - y) ^ 2 < 16 ^ 2 }
-    else
-      placed[#placed + 1] = { unplaced = l }
     end
   end
+  -- Every label right next to its point if they all fit; else each point
+  -- gets a number there and its text goes in the list beside the plot (a
+  -- label farther away could be read as another point's).
+  local function attempt(numbered)
+    local saved = #boxes
+    local placed = {}
+    for n, l in ipairs(chart.labels) do
+      local x, y = to_px(chart.x, l.x, PL, PR), to_px(chart.y, l.y, PB, PT)
+      local text = numbered and tostring(n) or l.text
+      local spot = find_spot(x, y, text, numbered and { 3, 8, 14, 22, 32 } or { 5, 10 })
+      if not spot then
+        if not numbered then
+          for k = #boxes, saved + 1, -1 do boxes[k] = nil end
+          return nil
+        end
+        placed[#placed + 1] = { unplaced = l }
+      else
+        boxes[#boxes + 1] = spot
+        local ex, ey = math.max(spot[1], math.min(x, spot[3])), math.max(spot[2], math.min(y, spot[4]))
+        placed[#placed + 1] = { text = text, color = l.color, left = spot[1], middle = (spot[2] + spot[4]) / 2,
+                                leader = { x, y, ex, ey }, near = (ex - x) ^ 2 + (ey - y) ^ 2 < 16 ^ 2,
+                                listed = numbered and ("[" .. text .. "] " .. l.text) or nil, x = l.x, y = l.value or l.y }
+      end
+    end
+    return placed
+  end
+  local placed = attempt(false) or attempt(true)
   return placed
 end
 
@@ -107,7 +127,8 @@ local function axis_commands(name, axis)
 end
 
 -- chart = { title, x = axis, y = axis, series = {{name, points = {{x, y}...},
--- style = gnuplot "with ..." text}}, labels = {{x, y, text, color}}, notes = {text} }
+-- style = gnuplot "with ..." text}}, labels = {{x, y, text, color, value = the y to list, if not y}},
+-- notes = {text} }
 -- Writes base .. ".png" and base .. ".svg"; returns the labels it could not place.
 function M.render(chart, base)
   local placed = place(chart)
@@ -140,8 +161,22 @@ function M.render(chart, base)
   -- what could not be placed goes in a list under the key
   local notes = {}
   for _, n in ipairs(chart.notes or {}) do notes[#notes + 1] = n end
-  for _, l in ipairs(unplaced) do notes[#notes + 1] = string.format("%s (%.3g ms)", l.text, l.x) end
-  for i, n in ipairs(notes) do
+  for _, p in ipairs(placed) do
+    if p.listed then notes[#notes + 1] = string.format("%s: %.3g ms, %.3g", p.listed, p.x, p.y) end
+  end
+  for _, l in ipairs(unplaced) do notes[#notes + 1] = string.format("%s: %.3g ms, %.3g", l.text, l.x, l.value or l.y) end
+  -- each note wrapped to the width right of the plot, continuation lines indented
+  local width = math.floor((W - PR - 35) / (1.1 * CHAR_W))
+  local lines = {}
+  for _, n in ipairs(notes) do
+    local line = ""
+    for word in n:gmatch("%S+") do
+      if line ~= "" and #line + 1 + #word > width then lines[#lines + 1] = line; line = "    " .. word
+      else line = line == "" and word or (line .. " " .. word) end
+    end
+    lines[#lines + 1] = line
+  end
+  for i, n in ipairs(lines) do
     w(string.format("set label %d %s at screen %.6f, screen %.6f left tc rgb '#333333'", 900 + i, quote(n),
                     (PR + 25) / W, 1 - (PT + 200 + i * LINE_H * 1.1) / H))
   end

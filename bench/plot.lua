@@ -11,17 +11,8 @@ assert(csv_path and outdir, "usage: lua5.4 plot.lua sweep.csv outdir [scene ...]
 local wanted = {}
 for i = 3, #arg do wanted[arg[i]] = true end
 
-local rows, header = {}, nil
-for line in io.lines(csv_path) do
-  local f = {}
-  for v in (line .. ","):gmatch("([^,]*),") do f[#f + 1] = v end
-  if not header then header = f else
-    local r = {}
-    for i, k in ipairs(header) do r[k] = f[i] end
-    r.ms_step, r.error = tonumber(r.ms_step), tonumber(r.error)
-    rows[#rows + 1] = r
-  end
-end
+local sweep = require "sweep_rows"
+local rows, by_scene, order = sweep.read(csv_path)
 
 -- what each knob's value means, in words
 local knob_words = {
@@ -56,6 +47,9 @@ local error_words = {
   roll_speed_rel_err = "rolling speed, relative error",
   cradle_speed_rel_err = "speed of the last ball, relative error",
   energy_drift_rel = "energy drift over the run, relative",
+  tumble_energy_drift_rel = "energy drift of the free box over 20 s, relative",
+  oblique_spin_rel_err = "spin after the oblique impact, relative error",
+  break_energy_rel_err = "energy after the break, relative error",
 }
 
 local function pareto(points)
@@ -73,29 +67,7 @@ local function pareto(points)
   return front
 end
 
--- The default settings: the preset row if the sweep has one, else the grid
--- point with the same solver columns as the one-knob-off-default rows.
-local function find_default(pts)
-  for _, p in ipairs(pts) do if p.knob == "preset" and p.value == "default" then return p end end
-  local ref
-  for _, p in ipairs(pts) do if p.knob == "sleep" or p.knob == "reuse" then ref = p; break end end
-  if not ref then return nil end
-  for _, p in ipairs(pts) do
-    if p.knob == "grid" then
-      local same = true
-      for _, k in ipairs{ "substeps", "iterations", "relax", "correction", "warm", "model", "ccd", "friction" } do
-        if p[k] ~= ref[k] then same = false end
-      end
-      if same then return p end
-    end
-  end
-end
-
-local by_scene, order = {}, {}
-for _, r in ipairs(rows) do
-  if not by_scene[r.scene] then by_scene[r.scene] = {}; order[#order + 1] = r.scene end
-  table.insert(by_scene[r.scene], r)
-end
+local find_default = sweep.find_default
 
 for _, scene in ipairs(order) do
   if next(wanted) == nil or wanted[scene] then
@@ -109,7 +81,7 @@ for _, scene in ipairs(order) do
     -- exact answers (error 0) sit on the bottom edge of a log axis, at `floor`
     local positive = math.huge
     for _, p in ipairs(pts) do if p.error > 0 then positive = math.min(positive, p.error) end end
-    local floor = positive < math.huge and positive / 10 or 1e-6
+    local floor = positive < math.huge and positive / 30 or 1e-6
     local function Y(p) return binary and p.error or math.max(p.error, floor) end
     local xmin, xmax, ymin, ymax = math.huge, -math.huge, math.huge, -math.huge
     for _, p in ipairs(pts) do
@@ -129,6 +101,10 @@ for _, scene in ipairs(order) do
       y.ticks = chart.log_ticks(y.lo, y.hi)
       if positive == math.huge or ymin <= floor then
         y.names = {}
+        -- "exact" alone at the bottom: no ordinary tick next to it
+        local kept = {}
+        for _, t in ipairs(y.ticks) do if t > floor * 2.5 then kept[#kept + 1] = t end end
+        y.ticks = kept
         y.ticks[#y.ticks + 1] = floor
         table.sort(y.ticks)
         y.names[floor] = "exact"
@@ -155,14 +131,14 @@ for _, scene in ipairs(order) do
     for _, p in ipairs(front) do
       local text = label(p)
       if p == default then text = text .. " (default)" end
-      labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), text = text, color = "#990000" }
+      labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), value = p.error, text = text, color = "#990000" }
       seen[p] = true
     end
     for _, m in ipairs(marks) do
       local p = presets[m[1]]
       if p and not seen[p] then
         local text = p.knob == "preset" and label(p) or label(p) .. " (default)"
-        labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), text = text, color = "#333333" }
+        labels[#labels + 1] = { x = math.max(p.ms_step, xmin), y = Y(p), value = p.error, text = text, color = "#333333" }
       end
     end
     local unplaced = chart.render({
