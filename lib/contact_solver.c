@@ -173,7 +173,9 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
             double v2 = v3_dot(dv, c->t2) + v3_dot(wB, p->rb_t[1]) - v3_dot(wA, p->ra_t[1]);
             double n1 = o1 - p->tangent_mass[0] * v1;
             double n2 = o2 - p->tangent_mass[1] * v2;
-            coulomb_clamp(&n1, &n2, c->friction * p->normal_impulse);
+            double limit = c->friction * p->normal_impulse;
+            if (n1 * n1 + n2 * n2 > limit * limit)
+                coulomb_over_cone(&n1, &n2, o1, o2, v1, v2, p->tangent_mass[0], p->tangent_mass[1], limit);
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
             double d1 = n1 - o1, d2 = n2 - o2;

@@ -404,10 +404,14 @@ LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane
         lane_t mag2 = n1 * n1 + n2 * n2;
         lane_mask over = mag2 > limit * limit;
         if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
-            lane_t f;
-            for (int l = 0; l < LANES; l++) f[l] = coulomb_factor(mag2[l], limit[l]);
-            n1 *= f;
-            n2 *= f;
+            for (int l = 0; l < LANES; l++) {
+                if (!over[l]) continue;
+                double s1 = n1[l], s2 = n2[l];
+                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
+                                  limit[l]);
+                n1[l] = s1;
+                n2[l] = s2;
+            }
         }
         p->tangent_impulse[0] = n1;
         p->tangent_impulse[1] = n2;
