@@ -163,8 +163,10 @@ static void add_rim_point(const vec3 v[3], vec3 n, const shape *cyl, xform x, do
  * edge or a vertex (a point inside the triangle: its face). Judged by the
  * clipped points, not by the triangle's vertex nearest the face's plane: a
  * face turned a hair off parallel to an internal edge would otherwise see
- * that edge's far vertex, active on a mesh's border a metre away. */
-static int face_contact_active(const vec3 v[3], vec3 n, unsigned active, vec3 fn, const manifold *alt)
+ * that edge's far vertex, active on a mesh's border a metre away.
+ * interior_ok: whether a point inside the triangle counts (not for a shape
+ * beside the triangle: its face reaches the triangle across an edge). */
+static int face_contact_active(const vec3 v[3], vec3 n, unsigned active, vec3 fn, const manifold *alt, int interior_ok)
 {
     int deepest = 0;
     for (int i = 1; i < alt->count; i++)
@@ -173,7 +175,7 @@ static int face_contact_active(const vec3 v[3], vec3 n, unsigned active, vec3 fn
     double scale = v3_len(v3_sub(v[1], v[0])) + v3_len(v3_sub(v[2], v[0]));
     int on[3], count = 0;
     for (int k = 0; k < 3; k++) count += on[k] = v3_dot(edge_side(v, n, k), v3_sub(q, v[k])) >= -1e-9 * scale;
-    if (count == 0) return 1;
+    if (count == 0) return interior_ok;
     if (count >= 2) return vertex_active(active, on[0] && on[1] ? 1 : on[1] && on[2] ? 2 : 0);
     return (int)(active >> (on[0] ? 0 : on[1] ? 1 : 2) & 1u);
 }
@@ -235,26 +237,42 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
     if (cyl) add_rim_point(v, n, s, xs, spec, m);
     /* another axis that separates more, from an active feature of the
      * triangle, replaces it when its contact is nearer: the face's points,
-     * clipped to the triangle, can miss the shape's nearest corner */
+     * clipped to the triangle, can miss the shape's nearest corner. A shape
+     * beside the triangle has no points over its face at all: then the
+     * better of the other axes, however little better (else a box touching
+     * a border edge had no contact) */
     manifold alt;
     memset(&alt, 0, sizeof alt);
-    if (ek >= 0 && sep_e > dmax(sep_t, sep_f) + TRI_FACE_TOLERANCE && (active >> ek & 1u)) {
+    int beside = m->count == 0;
+    double prefer_face = beside ? 0 : TRI_FACE_TOLERANCE;
+    if (ek >= 0 && (active >> ek & 1u) &&
+        (beside ? !(best_f >= 0 && sep_f > sep_e) : sep_e > dmax(sep_t, sep_f) + TRI_FACE_TOLERANCE)) {
         vec3 ca, cb;
         closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
         alt.normal = en;
         push_point(&alt, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
-    } else if (best_f >= 0 && sep_f > sep_t + TRI_FACE_TOLERANCE && !(ek >= 0 && sep_e > sep_f + TRI_FACE_TOLERANCE) &&
-               !(cyl && best_f < CYL_SIDES)) { /* a prism facet only approximates a round side */
+    } else if (best_f >= 0 && (beside || sep_f > sep_t + TRI_FACE_TOLERANCE) &&
+               !(ek >= 0 && (active >> ek & 1u) && sep_e > sep_f + prefer_face) &&
+               (beside || !(cyl && best_f < CYL_SIDES))) { /* a prism facet only approximates a round side */
         poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, &alt);
-        if (alt.count > 0 && !face_contact_active(v, n, active, p->fn[best_f], &alt)) alt.count = 0;
+        if (alt.count > 0 && !face_contact_active(v, n, active, p->fn[best_f], &alt, !beside)) alt.count = 0;
     }
     if (alt.count > 0) *m = alt;
     /* apart: points clipped to a reference face can miss the nearest corner
      * of the other side; the separating axes bound the distance from below,
-     * so no point may claim more room than they do */
+     * so no point may claim more room than they do. Overlapping on every
+     * axis: the deepest point is at least as deep as the best axis says
+     * (the face's points, clipped to the triangle, can all lie above its
+     * plane while the shape's side cuts into a border edge) */
     double bound = dmax(sep_t, dmax(sep_f, sep_e));
-    if (bound > 0)
+    if (bound > 0) {
         for (int i = 0; i < m->count; i++) m->points[i].separation = dmin(m->points[i].separation, bound);
+    } else if (m->count > 0) {
+        int deepest = 0;
+        for (int i = 1; i < m->count; i++)
+            if (m->points[i].separation < m->points[deepest].separation) deepest = i;
+        if (m->points[deepest].separation > bound) m->points[deepest].separation = bound;
+    }
 }
 
 /* Prepared once per pair: the convex shape in world space. */
