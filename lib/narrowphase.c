@@ -532,6 +532,7 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
     /* reference face: a's unless b's separates clearly more; keep last step's choice when close */
     int use_b = sb_best > sa_best + KEEP_TOLERANCE;
     if (cache->feature >= 0 && fabs(sb_best - sa_best) <= KEEP_TOLERANCE) use_b = cache->flip;
+    int sat_fa = fa, sat_fb = fb, sat_use_b = use_b;
     if (sa->type == SHAPE_CYLINDER || sb->type == SHAPE_CYLINDER) {
         /* the prism's facets only approximate a round side: ask libccd about the
          * true cylinder and take the face most aligned with its normal */
@@ -550,6 +551,30 @@ static void poly_poly(const shape *sa, xform xa, const shape *sb, xform xb, doub
     cache->flip = use_b;
     if (use_b) poly_face_contact(pb, fb, pa, sa->type == SHAPE_CYLINDER ? sa : NULL, xa, 1, spec, 0x20000000u, m);
     else poly_face_contact(pa, fa, pb, sb->type == SHAPE_CYLINDER ? sb : NULL, xb, 0, spec, 0, m);
+    if (m->count == 0 && (fa != sat_fa || fb != sat_fb || use_b != sat_use_b)) {
+        /* libccd's face found no point while every axis says they overlap:
+         * the separating-axis faces do */
+        cache->feature = sat_use_b ? sat_fb : sat_fa;
+        cache->flip = sat_use_b;
+        if (sat_use_b) poly_face_contact(pb, sat_fb, pa, sa->type == SHAPE_CYLINDER ? sa : NULL, xa, 1, spec, 0x20000000u, m);
+        else poly_face_contact(pa, sat_fa, pb, sb->type == SHAPE_CYLINDER ? sb : NULL, xb, 0, spec, 0, m);
+    }
+    if (m->count == 0) {
+        /* a narrow reference facet (a prism's side) can clip the whole incident
+         * feature away: the incident body's deepest vertex along the separating
+         * face's normal, at that axis' separation */
+        const poly *ref = sat_use_b ? pb : pa, *inc = sat_use_b ? pa : pb;
+        int rf = sat_use_b ? sat_fb : sat_fa;
+        vec3 n = ref->fn[rf];
+        int deepest = 0;
+        for (int i = 1; i < inc->nv; i++)
+            if (v3_dot(inc->v[i], n) < v3_dot(inc->v[deepest], n)) deepest = i;
+        double sep = v3_dot(inc->v[deepest], n) - ref->fd[rf];
+        if (sep < spec) {
+            m->normal = sat_use_b ? v3_neg(n) : n;
+            add_point(m, v3_madd(inc->v[deepest], -0.5 * sep, n), sep, 0x30000000u | (uint32_t)deepest);
+        }
+    }
 }
 
 /* poly_face_contact for a box face against a box, without building either
@@ -693,6 +718,56 @@ static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double
 
 /* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */
 
+/* Distance from a core outside the polytope (point c0, or segment c0-c1) to
+ * the inside of face f: the core clipped to the face's side planes, the
+ * nearest remaining point to its plane (written to *at); 1e300 when no
+ * part of the core lies over the face or it is behind the plane. */
+static double core_face_distance(const poly *p, int f, vec3 c0, vec3 c1, int seg, vec3 *at)
+{
+    clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
+    int nb = seg ? 2 : 1;
+    b1[0].p = c0; b1[0].id = 0;
+    b1[1].p = c1; b1[1].id = 1;
+    clip_vertex *in = b1, *out = b2;
+    vec3 n = p->fn[f];
+    int rc = p->fcount[f];
+    for (int e = 0; e < rc && nb > 0; e++) {
+        vec3 a = p->v[p->fv[p->ffirst[f] + e]], b = p->v[p->fv[p->ffirst[f] + (e + 1) % rc]];
+        vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
+        if (nb == 2) {
+            nb = clip_polygon(in, 2, side, v3_dot(side, a), (uint32_t)e, out);
+            if (nb > 2) nb = 2;
+        } else {
+            nb = v3_dot(side, in[0].p) <= v3_dot(side, a) + 1e-12 ? 1 : 0;
+            out[0] = in[0];
+        }
+        clip_vertex *t = in; in = out; out = t;
+    }
+    double best = 1e300;
+    for (int i = 0; i < nb; i++) {
+        double d = v3_dot(n, in[i].p) - p->fd[f];
+        if (d >= 0 && d < best) { best = d; *at = in[i].p; }
+    }
+    return best;
+}
+
+/* 1 when the core (point c0, or segment c0-c1) meets the polytope: the part
+ * of it inside every face's half-space is not empty. (Every face plane
+ * having an end of the segment behind it is not enough: a segment can pass
+ * a corner that way.) */
+static int core_meets_poly(const poly *p, vec3 c0, vec3 c1)
+{
+    double t0 = 0.0, t1 = 1.0;
+    for (int f = 0; f < p->nf; f++) {
+        double d0 = v3_dot(p->fn[f], c0) - p->fd[f], d1 = v3_dot(p->fn[f], c1) - p->fd[f];
+        if (d0 > 0 && d1 > 0) return 0;
+        if (d0 > 0) t0 = dmax(t0, d0 / (d0 - d1));
+        else if (d1 > 0) t1 = dmin(t1, d0 / (d0 - d1));
+        if (t0 > t1) return 0;
+    }
+    return 1;
+}
+
 static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, double spec, manifold *m)
 {
     poly pbuf;
@@ -730,9 +805,10 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
         }
         clip_vertex *t = in; in = out; out = t;
     }
-    if (best > 0 && nb == 0) {
-        /* outside, and the core does not project onto the face: the nearest
-         * feature is an edge or a vertex */
+    if (!core_meets_poly(p, c0, c1)) {
+        /* outside: the nearest feature may be this face, another face, an edge
+         * or a vertex (the part of the core over the best face can be the far
+         * part, the near end hanging past an edge) */
         double ebest = 1e300;
         vec3 ep = v3_zero(), ec = v3_zero();
         int eidx = 0;
@@ -743,11 +819,30 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
             if (d2 < ebest) { ebest = d2; ep = pa; ec = pc; eidx = i; }
         }
         ebest = sqrt(ebest);
-        vec3 en = any_unit(v3_sub(ec, ep), n);
-        double sep = ebest - r;
-        m->normal = en;
-        if (sep < spec) add_point(m, v3_madd(ep, 0.5 * sep, en), sep, 0x10000000u | (uint32_t)eidx);
-        return;
+        int face = -1;
+        double fbest = 1e300;
+        vec3 fc = c0;
+        for (int f = 0; f < p->nf; f++) {
+            vec3 pc = c0;
+            double d = core_face_distance(p, f, c0, c1, seg, &pc);
+            if (d < fbest) { fbest = d; face = f; fc = pc; }
+        }
+        if (ebest - r >= spec && fbest - r >= spec) {
+            m->normal = n;
+            return;
+        }
+        if (!(face == bf && nb > 0 && fbest <= ebest)) {
+            /* one point at the nearest feature */
+            int on_face = face >= 0 && fbest <= ebest;
+            double d = on_face ? fbest : ebest;
+            if (on_face) { ec = fc; ep = v3_madd(fc, -fbest, p->fn[face]); }
+            vec3 en = on_face ? p->fn[face] : any_unit(v3_sub(ec, ep), n);
+            double sep = d - r;
+            m->normal = en;
+            uint32_t id = on_face ? ((uint32_t)face << 16) | 0x8000u : 0x10000000u | (uint32_t)eidx;
+            if (sep < spec) add_point(m, v3_madd(ep, 0.5 * sep, en), sep, id);
+            return;
+        }
     }
     m->normal = n;
     if (best - r >= spec) return;
