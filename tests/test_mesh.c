@@ -185,12 +185,11 @@ static void test_separate_patches_like_plane(void **state) { (void)state; check_
 /* Separate mesh patches and box tiles varied one thing at a time: presets,
  * time steps 1/15..1/240 s, 1 km from the origin, patch sizes, patches of
  * 2 x 2 and 3 x 3 cells with random diagonals, speeds, headings (0: along
- * the seams), sizes; 4 s each. The rolling sphere meets the target in
- * every case. The sliding box does not in some (measured, tiles and
- * patches alike, so the seam pass between bodies rather than the mesh
- * contacts): fast preset |vz| 1.31 mm/s; dt 1/15 s 25 mm (tiles) and 4 mm
- * (patches); dt 1/30 s 1.9 mm; 0.5 m tiles 1.4 mm; a 1.2 m box 1.2 and
- * 2.0 mm. Those box cases are left out here until fixed. */
+ * the seams), sizes; 4 s each. Both movers meet the target in every case
+ * but one: the sliding box at the fast preset reaches 1.31 mm/s vertical
+ * while it straddles a seam (it rocks on the merged manifold; on the plane
+ * at fast 3e-7 m/s), tiles and patches alike. That case holds the sphere
+ * only until fixed. */
 typedef struct varied_case { mover_case mc; int movers; } varied_case;
 
 static void test_separate_floors_varied(void **state)
@@ -206,18 +205,18 @@ static void test_separate_floors_varied(void **state)
     } while (0)
     VARY(preset, "fast", 2);
     VARY(preset, "accurate", 3);
-    VARY(dt, 1.0 / 15.0, 2);
-    VARY(dt, 1.0 / 30.0, 2);
+    VARY(dt, 1.0 / 15.0, 3);
+    VARY(dt, 1.0 / 30.0, 3);
     VARY(dt, 1.0 / 240.0, 3);
     VARY(far_x, 1000.0, 3);
-    VARY(patch, 0.5, 2);
+    VARY(patch, 0.5, 3);
     VARY(patch, 2.5, 3);
     VARY(patch_cells, 2, 3);
     VARY(speed_scale, 0.3, 3);
     VARY(angle, 0.0, 3);
     VARY(angle, 1.2, 3);
     VARY(size, 0.1, 3);
-    VARY(size, 0.6, 2);
+    VARY(size, 0.6, 3);
 #undef VARY
     cases[n].mc = base; cases[n].mc.patch = 2.0; cases[n].mc.patch_cells = 3; cases[n++].movers = 3;
     /* twice as fast for half as long: the box stays on the floor */
