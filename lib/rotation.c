@@ -40,8 +40,9 @@ static mat3 skew(vec3 a) { return m3_cols(v3(0, a.z, -a.y), v3(-a.z, 0, a.x), v3
  * when the solve did not converge: y x Iinv y is normal to y, so every root
  * has |y|^2 = y.y0 <= |y0|^2, and Newton started from y0 can run off (and
  * overflow) when the body turns many radians in h. */
-static int midpoint_momentum(vec3 y0, mat3 inv_inertia, double h, vec3 *out)
+static int midpoint_momentum(vec3 y0, const mat3 *inv_inertia_p, double h, vec3 *out)
 {
+    const mat3 inv_inertia = *inv_inertia_p;
     vec3 y = y0;
     double tol2 = 1e-30 * v3_len2(y0);
     for (int it = 0; it < 4; it++) {
@@ -68,7 +69,7 @@ static int midpoint_momentum(vec3 y0, mat3 inv_inertia, double h, vec3 *out)
  * and the energy as exactly), down to h / 2^ROTATION_MAX_HALVINGS, below
  * which the body turns about its starting rate (finite, L still exact).
  * Adds the rotation vector it turned by to *turned. */
-static quat free_step(quat q, mat3 inv_inertia_local, vec3 L, double h, int depth, vec3 *turned)
+static quat free_step(quat q, const mat3 *inv_inertia_local, vec3 L, double h, int depth, vec3 *turned)
 {
     vec3 y0 = q_inv_rotate(q, L), y;
     if (!midpoint_momentum(y0, inv_inertia_local, h, &y)) {
@@ -78,17 +79,16 @@ static quat free_step(quat q, mat3 inv_inertia_local, vec3 L, double h, int dept
         }
         y = y0;
     }
-    vec3 w = q_rotate(q, m3_mulv(inv_inertia_local, y));
+    vec3 w = q_rotate(q, m3_mulv(*inv_inertia_local, y));
     *turned = v3_madd(*turned, h, w);
     return q_integrate(q, w, h);
 }
 
-quat rotation_free_step(quat q, mat3 inertia_local, mat3 inv_inertia_local, vec3 L, double h, vec3 *omega_mid)
+quat rotation_free_step(quat q, const mat3 *inv_inertia_local, vec3 L, double h, vec3 *omega_mid)
 {
-    (void)inertia_local;
     vec3 y0 = q_inv_rotate(q, L), y;
     if (midpoint_momentum(y0, inv_inertia_local, h, &y)) {
-        vec3 w = q_rotate(q, m3_mulv(inv_inertia_local, y));
+        vec3 w = q_rotate(q, m3_mulv(*inv_inertia_local, y));
         if (omega_mid) *omega_mid = w;
         return q_integrate(q, w, h);
     }
@@ -139,8 +139,8 @@ void rotation_step_method(rotation_method m, quat *q, vec3 *w, vec3 inertia, dou
     }
     case ROTATION_MIDPOINT: {
         vec3 wm;
-        mat3 I = m3_diag(inertia), Ii = m3_diag(inv);
-        *q = rotation_free_step(*q, I, Ii, L, h, &wm);
+        mat3 Ii = m3_diag(inv);
+        *q = rotation_free_step(*q, &Ii, L, h, &wm);
         *w = m3_mulv(world_tensor(*q, inv), L);
         return;
     }

@@ -5,13 +5,13 @@
 #include "vecmath.h"
 
 /* Advances orientation q by h for a body whose world-frame angular momentum L
- * is constant over h (no torque in between). inertia_local and
- * inv_inertia_local are the body-frame tensors. Implicit midpoint (Cayley) on
+ * is constant over h (no torque in between). inv_inertia_local is the
+ * body-frame inverse tensor. Implicit midpoint (Cayley) on
  * Euler's equations: world L is kept exactly and kinetic energy
  * L.I^-1 L / 2 to the solve's round-off at any step size. Writes the world
  * angular velocity the rotation used (the midpoint one) to *omega_mid when
  * not NULL. */
-quat rotation_free_step(quat q, mat3 inertia_local, mat3 inv_inertia_local, vec3 L, double h, vec3 *omega_mid);
+quat rotation_free_step(quat q, const mat3 *inv_inertia_local, vec3 L, double h, vec3 *omega_mid);
 
 /* The alternatives measured beside it (bench/rotation_methods.c):
  * ROTATION_CARRY_L: rotate about the current world w, then w = I_new^-1 L

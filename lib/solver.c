@@ -149,6 +149,9 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     void *p3 = realloc(s->delta_rotation, sizeof *s->delta_rotation * (size_t)cap);
     if (!p3) return 0;
     s->delta_rotation = p3;
+    void *p4 = realloc(s->inertia_start, sizeof *s->inertia_start * (size_t)cap);
+    if (!p4) return 0;
+    s->inertia_start = p4;
     impulse_body *bodies = s->bodies;
     memset(&bodies[0], 0, sizeof bodies[0]);
     s->delta_position[0] = v3_zero();
@@ -166,6 +169,8 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         bodies[k].w = clamp_length(bs->angular_velocity[i], wmax, &work->clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
+        /* once per step, not per sub-step: integrate_rotation's L = I w */
+        s->inertia_start[k] = m3_inverse(bodies[k].inv_inertia);
         s->delta_position[k] = v3_zero();
         s->delta_rotation[k] = v3_zero();
     }
@@ -182,6 +187,19 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
 static int touching_impact(const contact_constraint *c, const impulse_body *A, const impulse_body *B, vec3 ca, vec3 cb,
                            double max_push)
 {
+    /* a bound first (most pairs rest): at a point the normal speed is the
+     * centres' n.(vb - va) to within |wa| |ra| + |wb| |rb| */
+    double ra2 = -1.0, rb2 = 0.0;
+    for (int j = 0; j < c->count; j++) {
+        const manifold_point *mp = &c->m->points[j];
+        if (mp->separation > 0.0) continue;
+        ra2 = dmax(ra2, v3_len2(v3_sub(mp->point, ca)));
+        rb2 = dmax(rb2, v3_len2(v3_sub(mp->point, cb)));
+    }
+    if (ra2 < 0.0) return 0; /* nothing touches */
+    double centres = v3_dot(c->n, v3_sub(B->v, A->v));
+    double turn = sqrt(v3_len2(A->w) * ra2) + sqrt(v3_len2(B->w) * rb2);
+    if (centres - turn > -max_push + 1e-9 * (fabs(centres) + turn + max_push)) return 0;
     for (int j = 0; j < c->count; j++) {
         const manifold_point *mp = &c->m->points[j];
         if (mp->separation > 0.0) continue;
@@ -403,13 +421,12 @@ static void solve(carom_world *w, const step_context *ctx, const solver_work *wo
  * free body rotates with the midpoint w of Euler's equations (rotation.c);
  * the solver keeps w = I_start^-1 L for the step's impulses. Returns the
  * angular velocity the rotation used. */
-static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, double h)
+static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, const mat3 *inertia_start, double h)
 {
     vec3 wr = B->w;
     if (B->inv_mass > 0.0 && !(bs->flags[slot] & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION))) {
-        vec3 L = m3_mulv(m3_inverse(B->inv_inertia), B->w);
-        bs->rotation[slot] = rotation_free_step(bs->rotation[slot], bs->inertia_local[slot], bs->inv_inertia_local[slot],
-                                                L, h, &wr);
+        vec3 L = m3_mulv(*inertia_start, B->w);
+        bs->rotation[slot] = rotation_free_step(bs->rotation[slot], &bs->inv_inertia_local[slot], L, h, &wr);
     } else if (B->inv_mass == 0.0) {
         /* a kinematic body's w is constant: turn it by the exact exponential map */
         bs->rotation[slot] = q_normalize(q_mul(q_exp(v3_scale(wr, h)), bs->rotation[slot]));
@@ -439,7 +456,7 @@ static void integrate_positions_range(int begin, int end, int worker, void *p)
         bs->center[slot] = v3_add(bs->center[slot], dx);
         ctx->dp[b] = v3_add(ctx->dp[b], dx);
         if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
-            vec3 wr = integrate_rotation(bs, slot, B, h);
+            vec3 wr = integrate_rotation(bs, slot, B, &j->w->scratch.inertia_start[b], h);
             ctx->dq[b] = v3_madd(ctx->dq[b], h, wr);
         }
     }
@@ -571,7 +588,7 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
             /* the solver worked with the step's starting inertia; carry its angular
              * momentum L = I_start w to the new orientation (w = I_end^-1 L), so a
              * freely tumbling body conserves L rather than w */
-            vec3 L = m3_mulv(m3_inverse(B->inv_inertia), av);
+            vec3 L = m3_mulv(w->scratch.inertia_start[b], av);
             body_update_inertia(bs, slot);
             av = m3_mulv(bs->inv_inertia_world[slot], L);
             if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));

@@ -220,11 +220,31 @@ static sweep make_sweep(const carom_world *w, const step_context *step, int slot
     return sw;
 }
 
+/* An upper bound of how far a body's surface moved over the step (the
+ * centre's travel plus the turn at its bounding reach, which make_sweep's
+ * turn never exceeds): 1 when the body may need a sweep. A resting scene's
+ * bodies are all ruled out by it before any sweep is built. */
+static int may_need_sweep(const carom_world *w, const step_context *step, int slot)
+{
+    const body_store *s = &w->bodies;
+    int k = s->solver_index[slot];
+    if (s->type[slot] != CAROM_BODY_DYNAMIC || !(s->flags[slot] & BODY_AWAKE) || k <= 0) return 0;
+    if (s->flags[slot] & BODY_BULLET) return 1;
+    xform x0 = w->scratch.pose[slot];
+    vec3 c0 = v3_add(x0.p, q_rotate(x0.q, s->local_center[slot]));
+    double reach = shape_bounding_radius(&s->shapes[slot]) + v3_len(s->local_center[slot]);
+    double bound = v3_len(v3_sub(s->center[slot], c0)) + v3_len(step->dq[k]) * reach;
+    return !(bound <= min_extent(&s->shapes[slot])); /* NaN: let the sweep decide */
+}
+
 int world_continuous(carom_world *w, const step_context *step)
 {
     body_store *s = &w->bodies;
     step_scratch *sc = &w->scratch;
     int n = s->count;
+    int any = 0;
+    for (int i = 0; i < n && !any; i++) any = may_need_sweep(w, step, i);
+    if (!any) return 1;
     /* per slot: the sweep, the stop fraction and whether it is swept */
     size_t need = (sizeof(sweep) + sizeof(double) + sizeof(int)) * (size_t)(n > 0 ? n : 1);
     if (sc->toi_capacity < need) {
