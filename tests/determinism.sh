@@ -24,7 +24,7 @@ for cc in gcc clang; do
   wait
 done
 ref=""
-for exe in $out/scene_*; do
+for exe in $out/scene_gcc-O1 $out/scene_gcc-O2 $out/scene_clang-O1 $out/scene_clang-O2; do
   for path in avx2 sse2; do
     if [ $path = sse2 ]; then CAROM_NO_AVX2=1 ./$exe $exe.$path.snap; else ./$exe $exe.$path.snap; fi
     if [ -z "$ref" ]; then ref=$exe.$path.snap
