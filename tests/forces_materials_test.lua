@@ -194,5 +194,25 @@ test("torques and forces from a callback apply once, after it", function()
   _ = ground
 end)
 
+test("a force event's callback that errors or destroys the body", function()
+  local w, _, box = resting_box(1, 1, 1/60)
+  w:set_contact_callback(function(e) if e.type == "force" then error({ pressed = e.force }) end end)
+  local ok, err = pcall(w.step, w, 1/60)
+  assert(not ok and type(err) == "table" and math.abs(err.pressed - 9.81) < 0.1, "a table keeps its value")
+  w:set_contact_callback(function(e) if e.type == "force" then (e.a == box and e.a or e.b):destroy() end end)
+  w:step(1/60)
+  assert(not box:is_valid(), "destroyed at the end of the step")
+  w:step(1/60)
+  for _, e in ipairs(w:events()) do assert(e.type ~= "force") end
+  -- a sleeping pair raises none
+  local w2 = carom.world{}
+  w2:add_body{ type = "static", shape = carom.plane() }
+  local b2 = w2:add_body{ shape = carom.box{ half_extents = {0.25, 0.25, 0.25} }, position = {0, 0, 0.25},
+                          force_threshold = 1 }
+  w2:step(1/60, 120)
+  assert(not b2:is_awake())
+  for _, e in ipairs(w2:events()) do assert(e.type ~= "force", "asleep: no force events") end
+end)
+
 print(string.format("%d passed, %d failed", passed, failed))
 if failed > 0 then os.exit(1) end
