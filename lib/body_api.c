@@ -11,6 +11,8 @@
 #include "shape_def.h"
 #include "mesh.h"
 #include "deferred.h"
+#include "heightfield.h"
+#include "compound.h"
 
 #define MAX_COORDINATE RANGE_COORDINATE_MAX
 

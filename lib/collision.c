@@ -10,6 +10,8 @@
 #include "collision.h"
 #include "events.h"
 #include "tasks.h"
+#include "triangle_contact.h"
+#include "compound.h"
 
 /* The broadphase reports pairs in the order its trees hold them, which
  * depends on their history; the pairs are added in (id, id) order instead, so

@@ -6,6 +6,8 @@
 #include <string.h>
 #include "narrowphase.h"
 #include "mesh.h"
+#include "triangle_contact.h"
+#include "compound.h"
 
 void compound_free(compound *c)
 {

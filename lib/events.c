@@ -4,6 +4,7 @@
 #include "array.h"
 #include "world.h"
 #include "events.h"
+#include "compound.h"
 
 static int push_event(carom_world *w, const carom_contact_event *e, int contact_index)
 {

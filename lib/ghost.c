@@ -26,6 +26,8 @@
 #include "ghost.h"
 #include "manifold.h"
 #include "mesh.h"
+#include "heightfield.h"
+#include "triangle_contact.h"
 
 #define GHOST_COS (1.0 - 1e-12) /* normals this close are one surface's (the reach test decides the rest) */
 

@@ -8,6 +8,7 @@
 #include <string.h>
 #include "mesh.h"
 #include "ranges.h"
+#include "heightfield.h"
 
 void heightfield_free(height_field *h)
 {

@@ -6,6 +6,7 @@
 #include <string.h>
 #include "material.h"
 #include "ranges.h"
+#include "compound.h"
 
 static carom_material read_material(const carom_material *src)
 {

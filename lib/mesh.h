@@ -54,14 +54,6 @@ void mesh_query(const tri_mesh *m, aabb box, tri_visit_fn *visit, void *ctx);
 /* Nearest front-face hit (both faces when two-sided) of o + t d, t in [0, max_t]. */
 int mesh_ray_cast(const tri_mesh *m, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, uint32_t *index);
 
-height_field *heightfield_build(const double *heights, int rows, int columns, double cell_x, double cell_y,
-                                const int *holes, int hole_count, char *err, int err_size);
-void heightfield_free(height_field *h);
-aabb heightfield_bounds(const height_field *h);
-void heightfield_query(const height_field *h, aabb box, tri_visit_fn *visit, void *ctx);
-int heightfield_ray_cast(const height_field *h, vec3 o, vec3 d, double max_t, double *t, vec3 *normal,
-                         uint32_t *index);
-
 /* Whether the edge p -> q of a triangle with unit normal n is active, given
  * the opposite vertex w of the neighbour across it. */
 int mesh_edge_active(vec3 n, vec3 p, vec3 q, vec3 w, int two_sided);

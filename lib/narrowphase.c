@@ -6,6 +6,7 @@
 #include <string.h>
 #include <ccd/ccd.h>
 #include "manifold.h"
+#include "compound.h"
 
 #define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
 #define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */

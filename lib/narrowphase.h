@@ -40,26 +40,36 @@ int collide(const shape *a, xform xa, const shape *b, xform xb, double speculati
 /* Most manifolds a convex shape gets against one mesh or height field. */
 #define COMPOSITE_MAX_MANIFOLDS 4
 
-/* A mesh or height field (either of a, b) against a convex shape: the
- * triangles' contacts grouped by normal into up to `max` manifolds (normal
- * from a to b), written to out; returns how many. triangle_contact.c. */
-int collide_composite(const shape *a, xform xa, const shape *b, xform xb, double speculative, manifold *out, int max);
-/* One triangle (world vertices, counter-clockwise seen from the front) against
- * a convex shape; active: bit k set when edge v[k] -> v[k+1] is active (see
- * mesh.h). The normal points from the triangle to the shape. */
-int collide_triangle(const vec3 v[3], unsigned active, int two_sided, const shape *s, xform xs, double speculative,
-                     manifold *m);
-
 /* Most manifolds one pair gets (compound children, each against a mesh in
  * up to COMPOSITE_MAX_MANIFOLDS). */
 #define PAIR_MAX_MANIFOLDS 64
-/* Any pair with a mesh, height field or compound on either side: its
- * manifolds (normal a to b) and for each the base of its contact numbers
- * (a multiple of COMPOSITE_MAX_MANIFOLDS naming the child pair); returns how
- * many. compound.c. */
-int collide_multi(const shape *a, xform xa, const shape *b, xform xb, double speculative, manifold *out,
-                  uint32_t *base, int max);
-/* The compound children a contact number `sub` of the pair belongs to (-1: not a compound). */
-void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *child_a, int *child_b);
+
+#define POLY_MAX_V HULL_MAX_VERTICES
+#define POLY_MAX_F HULL_MAX_FACES
+#define POLY_MAX_FV HULL_MAX_FACE_VERTICES
+#define CYL_SIDES 16
+
+/* A convex polytope in world space (narrowphase.c builds them from shapes). */
+typedef struct poly {
+    int nv, nf, ne;
+    vec3 v[POLY_MAX_V];
+    vec3 fn[POLY_MAX_F];
+    double fd[POLY_MAX_F];
+    int ffirst[POLY_MAX_F], fcount[POLY_MAX_F];
+    int fv[POLY_MAX_FV];
+    int e[POLY_MAX_FV / 2][2];
+    int ef[POLY_MAX_FV / 2][2];      /* the two faces beside each edge (Gauss-map arcs) */
+    vec3 center;
+} poly;
+
+/* The polytope helpers, shared with the triangle contacts. */
+int poly_from_shape(poly *p, const shape *s, xform x);   /* box, hull, cylinder (a prism); 0 otherwise */
+void poly_finish(poly *p);                               /* centre and face offsets from v, fn, fv */
+void poly_edge_faces(poly *p);                           /* ef from the faces */
+/* Incident face of inc clipped against reference face rf of ref (see narrowphase.c). */
+void poly_face_contact(const poly *ref, int rf, const poly *inc, const shape *inc_cyl, xform inc_x, int flip,
+                       double spec, uint32_t tag, manifold *m);
+void closest_segments(vec3 p1, vec3 q1, vec3 p2, vec3 q2, vec3 *c1, vec3 *c2);
+void capsule_segment(const shape *s, xform x, vec3 *p0, vec3 *p1);
 
 #endif

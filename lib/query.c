@@ -20,6 +20,8 @@
 #include "ranges.h"
 #include "shape_def.h"
 #include "world.h"
+#include "heightfield.h"
+#include "compound.h"
 
 static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
 static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }

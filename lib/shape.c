@@ -7,6 +7,8 @@
 #include "array.h"
 #include "shape.h"
 #include "mesh.h"
+#include "heightfield.h"
+#include "compound.h"
 
 #define PI 3.14159265358979323846
 #define PLANE_EXTENT 1e18

@@ -55,13 +55,6 @@ typedef struct mass_props {
     mat3 inertia;          /* about the centre of mass, body axes */
 } mass_props;
 
-/* compound.c */
-void compound_free(compound *c);
-/* Mass properties combined exactly (parallel axis); each child at its own density. */
-mass_props compound_mass(const compound *c);
-aabb compound_aabb(const compound *c, xform t);
-int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child);
-
 /* Volume of a shape (0 for a plane). */
 double shape_volume(const shape *s);
 /* Mass properties for a density (kg/m^3). */

@@ -20,6 +20,8 @@
 #include "ranges.h"
 #include "narrowphase.h"
 #include "mesh.h"
+#include "heightfield.h"
+#include "compound.h"
 
 #define SNAP_MAGIC "CAROMSNP"
 #define SNAP_VERSION 2u

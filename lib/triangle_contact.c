@@ -23,6 +23,8 @@
 #include <string.h>
 #include "manifold.h"
 #include "mesh.h"
+#include "heightfield.h"
+#include "triangle_contact.h"
 
 #define TRI_FACE_TOLERANCE 1e-3   /* prefer the triangle's face unless another axis separates more (m) */
 #define GROUP_COS 0.999           /* polytope contacts within ~2.5 degrees of a group's normal join it */

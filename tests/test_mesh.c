@@ -18,6 +18,7 @@
 #include "manifold.h"
 #include "mesh.h"
 #include "mesh_scenes.h"
+#include "triangle_contact.h"
 
 static const carom_quat identity = {1, 0, 0, 0};
 

@@ -14,6 +14,7 @@
 #include "shape.h"
 #include "mesh.h"
 #include "helpers.h"
+#include "heightfield.h"
 
 
 /* ---- helpers ------------------------------------------------------------------ */
