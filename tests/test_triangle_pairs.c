@@ -35,6 +35,7 @@
 #include "narrowphase.h"
 #include "manifold.h"
 #include "shape.h"
+#include "triangle_contact.h"
 
 #define SPEC 0.05
 
