@@ -58,6 +58,15 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
     vec3 ca = c->center_a, cb = c->center_b;
     double ws = ctx->warm_starting ? 1.0 : 0.0;
     double deepest = 0.0;
+    /* the linear share of each row's inverse effective mass: a plane-locked
+     * body's 1/m counts only the row's part in its plane (its inverse inertia
+     * is already the reduced n n^T / (n.I n)) */
+    double lin_n = A->inv_mass + B->inv_mass, lin_1 = lin_n, lin_2 = lin_n;
+    if (c->locked) {
+        lin_n = locked_inv_mass(A->inv_mass, c->n, c->lock_a) + locked_inv_mass(B->inv_mass, c->n, c->lock_b);
+        lin_1 = locked_inv_mass(A->inv_mass, c->t1, c->lock_a) + locked_inv_mass(B->inv_mass, c->t1, c->lock_b);
+        lin_2 = locked_inv_mass(A->inv_mass, c->t2, c->lock_a) + locked_inv_mass(B->inv_mass, c->t2, c->lock_b);
+    }
     for (int j = 0; j < c->count; j++) {
         const manifold_point *mp = &c->m->points[j];
         constraint_point *p = &c->p[j];
@@ -77,14 +86,9 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         }
         /* the seed's denominator 1/m1 + 1/m2 + n.((I1^-1 (r1 x n)) x r1) + ..., from the
          * rows above: n.((I^-1 (r x n)) x r) = (I^-1 (r x n)).(r x n) */
-        /* (a plane-locked body's 1/m counts only the row's part in its plane;
-         * its inverse inertia is already the reduced n n^T / (n.I n)) */
-        double kn = locked_inv_mass(A->inv_mass, c->n, c->lock_a) + locked_inv_mass(B->inv_mass, c->n, c->lock_b) +
-                    v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
-        double k1 = locked_inv_mass(A->inv_mass, c->t1, c->lock_a) + locked_inv_mass(B->inv_mass, c->t1, c->lock_b) +
-                    v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
-        double k2 = locked_inv_mass(A->inv_mass, c->t2, c->lock_a) + locked_inv_mass(B->inv_mass, c->t2, c->lock_b) +
-                    v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
+        double kn = lin_n + v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
+        double k1 = lin_1 + v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
+        double k2 = lin_2 + v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
         p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
         p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
         p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
@@ -124,7 +128,17 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
 
 /* Normal then friction rows of one manifold; use_bias selects the solve pass
  * (position error fed back) over the relax pass (velocity only). */
-void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces)
+#if defined(__GNUC__)
+#define SOLVE_INLINE static inline __attribute__((always_inline))
+#else
+#define SOLVE_INLINE static inline
+#endif
+
+/* contact_solve's body, built twice: `locked` (a constant in each build)
+ * keeps plane-locked bodies' velocities in their planes after every row; the
+ * build for free bodies carries none of it. */
+SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces,
+                                 const int locked)
 {
     impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
     vec3 vA = A->v, wA = A->w, vB = B->v, wB = B->w;
@@ -134,7 +148,8 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
     vec3 dqa = ctx->dq[c->a], dqb = ctx->dq[c->b];
     int soft = ctx->correction == CAROM_CORRECTION_SOFT;
     int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
-    for (int i = 0; i < c->count; i++) {
+    const int count = c->count;
+    for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
         /* current separation: small-angle update of the anchors */
         double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, p->rb_n) - v3_dot(dqa, p->ra_n);
@@ -162,11 +177,11 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
         wA = v3_madd(wA, -lambda, p->ia_n);
         vB = v3_madd(vB, mB * lambda, n);
         wB = v3_madd(wB, lambda, p->ib_n);
-        if (c->locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
+        if (locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
     }
     if (ctx->friction && c->friction > 0) {
         vec3 dv = v3_sub(vB, vA);
-        for (int i = 0; i < c->count; i++) {
+        for (int i = 0; i < count; i++) {
             constraint_point *p = &c->p[i];
             double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
             double v1 = v3_dot(dv, c->t1) + v3_dot(wB, p->rb_t[0]) - v3_dot(wA, p->ra_t[0]);
@@ -184,13 +199,19 @@ void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias,
             vB = v3_madd(vB, mB, P);
             wA = v3_sub(wA, v3_add(v3_scale(p->ia_t[0], d1), v3_scale(p->ia_t[1], d2)));
             wB = v3_add(wB, v3_add(v3_scale(p->ib_t[0], d1), v3_scale(p->ib_t[1], d2)));
-            if (c->locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
+            if (locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
             dv = v3_sub(vB, vA);
         }
     }
     if (c->rolling > 0.0) solve_rolling(c, &wA, &wB, A, B);
     A->v = vA; A->w = wA;
     B->v = vB; B->w = wB;
+}
+
+void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces)
+{
+    if (c->locked) solve_manifold(c, ctx, use_bias, hold_bounces, 1);
+    else solve_manifold(c, ctx, use_bias, hold_bounces, 0);
 }
 
 /* Shock propagation (Guendelman et al. 2003): the body nearer the ground is

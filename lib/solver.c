@@ -469,13 +469,17 @@ static void integrate_positions(carom_world *w, const step_context *ctx, const s
 }
 
 /* The step's last relax pass holds bounces (see contact_solve) where the
- * impact phase runs. */
+ * impact phase runs. The shock pass relaxes even without relax passes
+ * (fast): the biased pass leaves a heavy body the push-out velocity the
+ * light one under it could not hold, and a 1000:1 pair at fast slid 19 mm
+ * in 10 s (1.1 mm with this pass; scenes without a heavy-on-light contact
+ * have no shock pass and pay nothing). */
 static void relax(carom_world *w, const step_context *ctx, const solver_work *work, int last)
 {
     if (ctx->penalty) return;
     int hold = last && work->impacts;
     for (int it = 0; it < ctx->relax_iterations; it++) solve_pass(ctx, work, 0, hold);
-    if (ctx->relax_iterations > 0) shock_pass(ctx, work, 0, hold);
+    shock_pass(ctx, work, 0, hold);
     project_planar(&w->bodies, ctx);
 }
 

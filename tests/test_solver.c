@@ -611,6 +611,55 @@ static void test_torsional_friction(void **state)
     spin_down("accurate", 1, 1.0, 1.0, 1.0 / 60, 1e5, 70, 0.25);
 }
 
+/* A heavy box on a light one on the ground (mu 0.6, 10 s) stays where it was
+ * put: within 5 mm at a 1000:1 ratio and 1 cm at 1e6:1, at every preset,
+ * dt 1/60..1/1000, sizes 0.1-2 m, far from the origin, heavy body created
+ * first or last. (Not at coarser steps: at dt 1/30 a 1000:1 pair moves
+ * 2.5 cm at default, at 1/15 6 cm.) */
+static void heavy_on_light(const char *preset, double ratio, double he, double dt, double x0, int heavy_first,
+                           double tol)
+{
+    carom_world_def wd = carom_world_def_default();
+    assert_int_equal(carom_world_def_apply_preset(&wd, preset), CAROM_OK);
+    wd.enable_sleep = 0;
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_box(10.0 * he, 10.0 * he, he);
+    g.position = vec(x0, 0, -he);
+    g.friction = 0.6;
+    assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+    carom_body_id heavy = {0}, light = {0};
+    if (heavy_first) heavy = add_box(w, x0, 0, 3.0 * he, he, ratio, 0.6);
+    light = add_box(w, x0, 0, he, he, 1.0, 0.6);
+    if (!heavy_first) heavy = add_box(w, x0, 0, 3.0 * he, he, ratio, 0.6);
+    step_n(w, (int)(10.0 / dt + 0.5), dt);
+    carom_vec3 p = pos(w, heavy);
+    double moved = sqrt(pow(p.x - x0, 2) + p.y * p.y + pow(p.z - 3.0 * he, 2));
+    char what[160];
+    snprintf(what, sizeof what, "%s %g:1 he %g dt 1/%.0f x0 %g %s first: heavy box moved (m)", preset, ratio, he,
+             1.0 / dt, x0, heavy_first ? "heavy" : "light");
+    EXPECT_NEAR(moved, 0.0, tol, what);
+    (void)light;
+    carom_world_destroy(w);
+}
+
+static void test_heavy_on_light_every_preset(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const double dts[] = {1.0 / 60, 1.0 / 120, 1.0 / 1000}, sizes[] = {0.1, 0.5, 2.0};
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++) {
+            heavy_on_light(presets[p], 1000.0, sizes[(p + k) % 3], dts[k], k == 1 ? 1e5 : 0.0, (p + k) % 2, 0.005);
+            heavy_on_light(presets[p], 1e6, sizes[(p + 2 * k) % 3], dts[k], k == 2 ? 1e5 : 0.0, (p + k + 1) % 2, 0.01);
+        }
+    /* the pair: unit boxes at dt 1/60 (fast slid 19 mm) */
+    heavy_on_light("fast", 1000.0, 0.5, 1.0 / 60, 0.0, 0, 0.005);
+    heavy_on_light("default", 1e6, 0.5, 1.0 / 60, 0.0, 0, 0.01);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -631,6 +680,7 @@ int main(void)
         cmocka_unit_test(test_resting_sag_is_the_soft_deflection),
         cmocka_unit_test(test_cylinder_rolls_on_plane_and_box),
         cmocka_unit_test(test_torsional_friction),
+        cmocka_unit_test(test_heavy_on_light_every_preset),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
