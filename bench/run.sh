@@ -69,6 +69,10 @@ phase "scaling: pile of 100 to 50,000 bodies"
 ../build/bench/scaling | tee out/scaling.csv
 if command -v gnuplot >/dev/null 2>&1; then lua5.4 plot_scaling.lua out/scaling.csv out/scaling; fi
 
+phase "scaling: pyramid grid, 990 to 49,995 bodies, every preset, threads, first step, memory (beside Box3D/Jolt if BOX3D_BENCH/JOLT_BENCH)"
+./scaling.sh out/pyramids.csv
+if command -v gnuplot >/dev/null 2>&1; then lua5.4 plot_scaling.lua out/pyramids.csv out/pyramids; fi
+
 phase "narrowphase cost per pair type"
 ../build/bench/bench_narrowphase | tee out/narrowphase.txt
 
@@ -86,4 +90,4 @@ lua5.4 publish.lua out ../docs/bench ../README.md
 
 echo
 echo "bench: done in $(elapsed); results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto.txt," \
-     "pareto_*.png/.svg, scaling.csv, scaling.png/.svg, narrowphase.txt, extremes.txt, snapshot.txt)"
+     "pareto_*.png/.svg, scaling.csv, scaling.png/.svg, pyramids.csv, pyramids_ms/_us.png/.svg, narrowphase.txt, extremes.txt, snapshot.txt)"

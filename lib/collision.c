@@ -364,7 +364,7 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
         return 1;
     }
     if (c->flags & CONTACT_PRECOMPUTED) {
-        touching = (c->flags & CONTACT_PRECOMPUTED_TOUCHING) != 0; /* precompute_manifolds did the work */
+        touching = (c->flags & CONTACT_PRECOMPUTED_TOUCHING) != 0; /* precompute_range did the work */
         c->flags &= ~(uint32_t)(CONTACT_PRECOMPUTED | CONTACT_PRECOMPUTED_TOUCHING);
     } else {
         touching = narrow_contact(w, i, ba, bb, spec, reuse, bounds_overlap);
@@ -436,8 +436,11 @@ int world_collide(carom_world *w, const step_context *ctx)
     if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
     if (!array_reserve((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
         return 0;
-    precompute_job job = {w, ctx, reuse};
-    tasks_run(&w->def, cs->count, CONTACT_MIN_RANGE, precompute_range, &job);
+    /* on one worker the pass below does the same work in place */
+    if (tasks_workers(&w->def) > 1) {
+        precompute_job job = {w, ctx, reuse};
+        tasks_run(&w->def, cs->count, CONTACT_MIN_RANGE, precompute_range, &job);
+    }
     /* ascending, and a removal re-examines index i (the last contact, not yet
      * seen, moves there), so the indices already listed stay valid */
     int woken = 0;
