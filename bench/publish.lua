@@ -18,7 +18,9 @@ local function copy(name)
   dst:write(data); dst:close()
 end
 for _, name in ipairs{ "peers.txt", "broadphase.txt", "narrowphase.txt", "extremes.txt", "pareto.txt",
-                       "terrain.txt", "snapshot.txt", "scaling.csv", "scaling.png", "scaling.svg" } do
+                       "terrain.txt", "snapshot.txt", "scaling.csv", "scaling.png", "scaling.svg",
+                       "pyramids.csv", "pyramids_switches.csv", "pyramids_ms.png", "pyramids_ms.svg",
+                       "pyramids_us.png", "pyramids_us.svg" } do
   copy(name)
 end
 local rows, by_scene = sweep.read(out .. "/sweep.csv")
