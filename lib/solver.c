@@ -260,6 +260,26 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->gravity_closing = v3_dot(c->n, v3_sub(acc_b, acc_a));
 }
 
+/* Constraints per range handed to the task hooks. */
+#define CONSTRAINT_MIN_RANGE 128
+
+/* A per-constraint loop's job. */
+typedef struct constraint_job {
+    carom_world *w;
+    const step_context *ctx;
+    contact_constraint *cc;
+    solver_work *work;
+} constraint_job;
+
+/* Each constraint from its own manifold (its points already placed). */
+static void fill_constraints_range(int begin, int end, int worker, void *p)
+{
+    const constraint_job *j = p;
+    const int *touching = j->w->scratch.touching;
+    (void)worker;
+    for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &j->cc[k], touching[k]);
+}
+
 static int build_constraints(carom_world *w, step_context *ctx, solver_work *work)
 {
     step_scratch *s = &w->scratch;
@@ -279,9 +299,10 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     work->in_contact = work->level_count + nb + 3;
     for (int k = 0; k < ncon; k++) {
         cc[k].p = point_pool;
-        fill_constraint(w, ctx, &cc[k], s->touching[k]);
-        point_pool += cc[k].count;
+        point_pool += cs->data[s->touching[k]].m.count;
     }
+    constraint_job job = {w, ctx, cc, NULL};
+    tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
     for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;
     ctx->constraints = cc;
@@ -510,11 +531,13 @@ static void finish_impacts(carom_world *w, const step_context *ctx, const solver
     if (work->impacts) impact_finish(w, ctx->body_count);
 }
 
-static void store_impulses(carom_world *w, const step_context *ctx)
+static void store_impulses_range(int begin, int end, int worker, void *p)
 {
-    for (int c = 0; c < ctx->constraint_count; c++) {
-        const contact_constraint *con = &ctx->constraints[c];
-        contact_data *cd = &w->contacts.data[con->contact];
+    const constraint_job *job = p;
+    (void)worker;
+    for (int c = begin; c < end; c++) {
+        const contact_constraint *con = &job->cc[c];
+        contact_data *cd = &job->w->contacts.data[con->contact];
         for (int j = 0; j < con->count; j++) {
             const constraint_point *p = &con->p[j];
             cd->state[j].normal_impulse = p->normal_impulse;
@@ -522,6 +545,12 @@ static void store_impulses(carom_world *w, const step_context *ctx)
             cd->state[j].tangent_impulse[1] = p->tangent_impulse[1];
         }
     }
+}
+
+static void store_impulses(carom_world *w, const step_context *ctx)
+{
+    constraint_job job = {w, ctx, ctx->constraints, NULL};
+    tasks_run(ctx->tasks, ctx->constraint_count, CONSTRAINT_MIN_RANGE, store_impulses_range, &job);
 }
 
 static void raise_hit_events(carom_world *w, const step_context *ctx)
@@ -546,7 +575,7 @@ static void raise_hit_events(carom_world *w, const step_context *ctx)
 }
 
 /* Never propagate NaN: undoes the body's motion this step and stops it. */
-static void reset_non_finite(carom_world *w, const step_context *ctx, int b, vec3 *v, vec3 *av)
+static void reset_non_finite(carom_world *w, const step_context *ctx, int b, vec3 *v, vec3 *av, int *non_finite)
 {
     body_store *bs = &w->bodies;
     int slot = ctx->body_slot[b];
@@ -556,24 +585,35 @@ static void reset_non_finite(carom_world *w, const step_context *ctx, int b, vec
     bs->rotation[slot] = q_normalize(bs->rotation[slot]); /* identity if it overflowed */
     *v = v3_zero();
     *av = v3_zero();
-    w->stats.non_finite++;
+    (*non_finite)++;
 }
+
+/* What finish_bodies counts, per worker (integer sums: any order adds up the same). */
+typedef struct finish_job {
+    carom_world *w;
+    const step_context *ctx;
+    int clamped[CAROM_MAX_WORKERS], non_finite[CAROM_MAX_WORKERS];
+} finish_job;
 
 /* Velocities back to the store, clamped and guarded; the new orientation's
  * inertia. */
-static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *work)
+static void finish_bodies_range(int begin, int end, int worker, void *p)
 {
+    finish_job *job = p;
+    carom_world *w = job->w;
+    const step_context *ctx = job->ctx;
+    int *clamped = &job->clamped[worker], *non_finite = &job->non_finite[worker];
     body_store *bs = &w->bodies;
     double vmax = w->def.max_linear_speed, wmax = world_spin_clamp(&w->def, ctx->h);
-    for (int b = 1; b < ctx->body_count; b++) {
+    for (int b = 1 + begin; b < 1 + end; b++) {
         int slot = ctx->body_slot[b];
         const impulse_body *B = &ctx->bodies[b];
         int angular_clamped = 0;
-        vec3 v = clamp_length(B->v, vmax, &work->clamped), av = clamp_length(B->w, wmax, &angular_clamped);
+        vec3 v = clamp_length(B->v, vmax, clamped), av = clamp_length(B->w, wmax, &angular_clamped);
         quat q = bs->rotation[slot];
         if (!v3_is_finite(v) || !v3_is_finite(av) || !v3_is_finite(bs->center[slot]) ||
             !(isfinite(q.w) && isfinite(q.x) && isfinite(q.y) && isfinite(q.z)))
-            reset_non_finite(w, ctx, b, &v, &av);
+            reset_non_finite(w, ctx, b, &v, &av, non_finite);
         bs->velocity[slot] = v;
         bs->angular_velocity[slot] = av;
         if (bs->flags[slot] & BODY_LOCK_PLANE) {
@@ -600,13 +640,27 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
             if (angular_clamped) av = clamp_length(av, wmax, &angular_clamped);
             if (!v3_is_finite(av)) { /* the ranges keep this finite; never let NaN through if not */
                 av = v3_zero();
-                w->stats.non_finite++;
+                (*non_finite)++;
             }
             bs->angular_velocity[slot] = av;
         } else {
             body_update_inertia(bs, slot);
         }
-        work->clamped += angular_clamped > 0;
+        *clamped += angular_clamped > 0;
+    }
+}
+
+static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *work)
+{
+    finish_job job;
+    job.w = w;
+    job.ctx = ctx;
+    int workers = tasks_workers(&w->def);
+    for (int k = 0; k < workers; k++) job.clamped[k] = job.non_finite[k] = 0;
+    tasks_run(ctx->tasks, ctx->body_count - 1, BODY_MIN_RANGE, finish_bodies_range, &job);
+    for (int k = 0; k < workers; k++) {
+        work->clamped += job.clamped[k];
+        w->stats.non_finite += job.non_finite[k];
     }
     w->stats.clamped += work->clamped;
     w->stats.awake_bodies = ctx->body_count - 1;
