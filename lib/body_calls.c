@@ -2,27 +2,10 @@
  * angular impulses, damping after creation, frame conversions, the shape
  * back as a def, and the previous pose for interpolation. */
 #include "body_calls.h"
+#include "body_args.h"
 #include "deferred.h"
 #include "ranges.h"
 #include "world.h"
-
-static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
-static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
-static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
-static int slot_of(const carom_world *w, carom_body_id id, const char *fn)
-{
-    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
-    if (slot < 0) world_fail(w, CAROM_ERROR_STALE_ID, "%s: body has been destroyed (or the id is invalid)", fn);
-    return slot;
-}
-
-#define SLOT_OR_FAIL(fn)                                       \
-    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;               \
-    int slot = slot_of(w, id, fn);                             \
-    if (slot < 0) return CAROM_ERROR_STALE_ID;
-#define OUT_OR_FAIL(p, fn) \
-    if (!(p)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: output pointer is NULL", fn);
 
 void world_remember_poses(carom_world *w)
 {
@@ -38,11 +21,11 @@ CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *w, carom_bo
     const char *fn = "body_apply_angular_impulse";
     SLOT_OR_FAIL(fn);
     if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_IMPULSE, id, impulse, NULL, fn);
-    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", fn);
-    if (!finite_c(impulse)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: impulse must be finite", fn);
+    UNLOCKED_OR_FAIL(fn);
+    if (!args_finite(impulse)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: impulse must be finite", fn);
     body_store *s = &w->bodies;
     if (s->type[slot] != CAROM_BODY_DYNAMIC || (s->flags[slot] & BODY_LOCK_ROTATION)) return CAROM_OK;
-    vec3 nw = v3_add(s->angular_velocity[slot], m3_mulv(s->inv_inertia_world[slot], to_v3(impulse)));
+    vec3 nw = v3_add(s->angular_velocity[slot], m3_mulv(s->inv_inertia_world[slot], args_v3(impulse)));
     if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
     if (!(v3_len(nw) <= world_spin_limit(&w->def)))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
@@ -57,7 +40,7 @@ CAROM_API carom_status carom_body_set_damping(carom_world *w, carom_body_id id, 
 {
     const char *fn = "body_set_damping";
     SLOT_OR_FAIL(fn);
-    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", fn);
+    UNLOCKED_OR_FAIL(fn);
     if (!(isfinite(linear) && linear >= 0 && linear <= RANGE_DAMPING_MAX))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: linear damping %g is outside [0, 1e6] 1/s", fn, linear);
     if (!(isfinite(angular) && angular >= 0 && angular <= RANGE_DAMPING_MAX))
@@ -83,11 +66,11 @@ static carom_status convert(const carom_world *w, carom_body_id id, carom_vec3 i
 {
     SLOT_OR_FAIL(fn);
     OUT_OR_FAIL(out, fn);
-    if (!finite_c(in)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: the vector must be finite", fn);
+    if (!args_finite(in)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: the vector must be finite", fn);
     xform x = body_xform(&w->bodies, slot);
-    vec3 v = to_v3(in);
-    if (is_point) *out = from_v3(to_world ? xf_point(x, v) : xf_inv_point(x, v));
-    else *out = from_v3(to_world ? q_rotate(x.q, v) : q_inv_rotate(x.q, v));
+    vec3 v = args_v3(in);
+    if (is_point) *out = args_c3(to_world ? xf_point(x, v) : xf_inv_point(x, v));
+    else *out = args_c3(to_world ? q_rotate(x.q, v) : q_inv_rotate(x.q, v));
     return CAROM_OK;
 }
 
@@ -125,7 +108,7 @@ CAROM_API carom_status carom_body_get_shape(const carom_world *w, carom_body_id 
         d.point_count = sh->hull->vertex_count;
     }
     if (sh->type == SHAPE_PLANE) {
-        d.normal = from_v3(sh->plane_normal);
+        d.normal = args_c3(sh->plane_normal);
         d.offset = sh->plane_offset;
     }
     *out = d;
@@ -137,7 +120,7 @@ CAROM_API carom_status carom_body_get_previous_position(const carom_world *w, ca
     const char *fn = "body_get_previous_position";
     SLOT_OR_FAIL(fn);
     OUT_OR_FAIL(out, fn);
-    *out = from_v3(w->bodies.previous_origin[slot]);
+    *out = args_c3(w->bodies.previous_origin[slot]);
     return CAROM_OK;
 }
 

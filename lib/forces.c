@@ -1,28 +1,11 @@
 /* forces.c - forces and torques for the next step (the solver integrates
  * them: linear acceleration f / m, angular momentum + torque h per
  * sub-step), force thresholds and the contact force events. */
+#include "body_args.h"
 #include "deferred.h"
 #include "events.h"
 #include "forces.h"
 #include "ranges.h"
-
-static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
-static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
-static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
-
-static int slot_of(const carom_world *w, carom_body_id id, const char *fn)
-{
-    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
-    if (slot < 0) world_fail(w, CAROM_ERROR_STALE_ID, "%s: body has been destroyed (or the id is invalid)", fn);
-    return slot;
-}
-
-#define SLOT_OR_FAIL(fn)                                       \
-    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;               \
-    int slot = slot_of(w, id, fn);                             \
-    if (slot < 0) return CAROM_ERROR_STALE_ID;
-#define UNLOCKED_OR_FAIL(fn) \
-    if (w->locked) return world_fail(w, CAROM_ERROR_LOCKED, "%s: the world is locked (inside step or a callback)", fn);
 
 /* The torque's angular acceleration I^-1 tau, bounded as a force's f / m is. */
 static carom_status add_torque(carom_world *w, int slot, vec3 torque, const char *fn)
@@ -45,10 +28,10 @@ CAROM_API carom_status carom_body_apply_torque(carom_world *w, carom_body_id id,
     SLOT_OR_FAIL(fn);
     if (w->in_callback) return world_defer_op(w, DEFER_TORQUE, id, torque, NULL, fn);
     UNLOCKED_OR_FAIL(fn);
-    if (!finite_c(torque)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: torque must be finite", fn);
+    if (!args_finite(torque)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: torque must be finite", fn);
     body_store *s = &w->bodies;
     if (s->type[slot] != CAROM_BODY_DYNAMIC || (s->flags[slot] & BODY_LOCK_ROTATION)) return CAROM_OK;
-    carom_status st = add_torque(w, slot, to_v3(torque), fn);
+    carom_status st = add_torque(w, slot, args_v3(torque), fn);
     if (st == CAROM_OK) world_wake_body(w, slot);
     return st;
 }
@@ -60,11 +43,11 @@ CAROM_API carom_status carom_body_apply_force_at_point(carom_world *w, carom_bod
     SLOT_OR_FAIL(fn);
     if (w->in_callback) return world_defer_op(w, DEFER_FORCE_AT_POINT, id, force, &point, fn);
     UNLOCKED_OR_FAIL(fn);
-    if (!finite_c(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: force must be finite", fn);
-    if (!finite_c(point)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: point must be finite", fn);
+    if (!args_finite(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: force must be finite", fn);
+    if (!args_finite(point)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: point must be finite", fn);
     body_store *s = &w->bodies;
     if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK;
-    vec3 f = to_v3(force), arm_torque = v3_cross(v3_sub(to_v3(point), s->center[slot]), f);
+    vec3 f = args_v3(force), arm_torque = v3_cross(v3_sub(args_v3(point), s->center[slot]), f);
     if (!v3_is_finite(arm_torque))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: the torque about the centre of mass is not finite", fn);
     /* both parts checked before either is kept: a refused call changes nothing */
@@ -86,8 +69,8 @@ CAROM_API carom_status carom_body_get_applied_force(const carom_world *w, carom_
     const char *fn = "body_get_applied_force";
     SLOT_OR_FAIL(fn);
     if (!force && !torque) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: both outputs are NULL", fn);
-    if (force) *force = from_v3(w->bodies.force[slot]);
-    if (torque) *torque = from_v3(w->bodies.torque[slot]);
+    if (force) *force = args_c3(w->bodies.force[slot]);
+    if (torque) *torque = args_c3(w->bodies.torque[slot]);
     return CAROM_OK;
 }
 

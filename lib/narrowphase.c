@@ -731,11 +731,9 @@ static void box_box(const shape *sa, xform xa, const shape *sb, xform xb, double
 
 /* ---- polytope against a sphere or capsule (a point or segment core + radius) -- */
 
-/* Distance from a core outside the polytope (point c0, or segment c0-c1) to
- * the inside of face f: the core clipped to the face's side planes, the
- * nearest remaining point to its plane (written to *at); 1e300 when no
- * part of the core lies over the face or it is behind the plane. */
-static double core_face_distance(const poly *p, int f, vec3 c0, vec3 c1, int seg, vec3 *at)
+/* The core (point c0, or segment c0-c1) clipped to face f's side planes:
+ * the part of it over the face, 0..2 points (ids 0 and 1: the ends). */
+static int clip_core_to_face(const poly *p, int f, vec3 c0, vec3 c1, int seg, clip_vertex kept[2])
 {
     clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
     int nb = seg ? 2 : 1;
@@ -756,10 +754,21 @@ static double core_face_distance(const poly *p, int f, vec3 c0, vec3 c1, int seg
         }
         clip_vertex *t = in; in = out; out = t;
     }
+    for (int i = 0; i < nb; i++) kept[i] = in[i];
+    return nb;
+}
+
+/* Distance from a core outside the polytope to the inside of face f: the
+ * nearest point of the part over the face to its plane (written to *at);
+ * 1e300 when no part of the core lies over the face or it is behind it. */
+static double core_face_distance(const poly *p, int f, vec3 c0, vec3 c1, int seg, vec3 *at)
+{
+    clip_vertex kept[2];
+    int nb = clip_core_to_face(p, f, c0, c1, seg, kept);
     double best = 1e300;
     for (int i = 0; i < nb; i++) {
-        double d = v3_dot(n, in[i].p) - p->fd[f];
-        if (d >= 0 && d < best) { best = d; *at = in[i].p; }
+        double d = v3_dot(p->fn[f], kept[i].p) - p->fd[f];
+        if (d >= 0 && d < best) { best = d; *at = kept[i].p; }
     }
     return best;
 }
@@ -799,25 +808,9 @@ static void poly_core(const shape *sp, xform xp, const shape *sc, xform xc, doub
     }
     if (bf < 0) return; /* no finite face distance */
     vec3 n = p->fn[bf];
-    /* clip the core (point or segment) to the reference face's side planes */
-    clip_vertex b1[CLIP_MAX], b2[CLIP_MAX];
-    int nb = seg ? 2 : 1;
-    b1[0].p = c0; b1[0].id = 0;
-    b1[1].p = c1; b1[1].id = 1;
-    clip_vertex *in = b1, *out = b2;
-    int rc = p->fcount[bf];
-    for (int e = 0; e < rc && nb > 0; e++) {
-        vec3 a = p->v[p->fv[p->ffirst[bf] + e]], b = p->v[p->fv[p->ffirst[bf] + (e + 1) % rc]];
-        vec3 side = v3_normalize(v3_cross(v3_sub(b, a), n));
-        if (nb == 2) {
-            nb = clip_polygon(in, 2, side, v3_dot(side, a), (uint32_t)e, out);
-            if (nb > 2) nb = 2;
-        } else {
-            nb = v3_dot(side, in[0].p) <= v3_dot(side, a) + 1e-12 ? 1 : 0;
-            out[0] = in[0];
-        }
-        clip_vertex *t = in; in = out; out = t;
-    }
+    /* the core (point or segment) clipped to the reference face's side planes */
+    clip_vertex in[2];
+    int nb = clip_core_to_face(p, bf, c0, c1, seg, in);
     if (!core_meets_poly(p, c0, c1)) {
         /* outside: the nearest feature may be this face, another face, an edge
          * or a vertex (the part of the core over the best face can be the far

@@ -140,6 +140,9 @@ void clua_read_filter_keys(lua_State *L, int arg, const char *fname, carom_body_
 void clua_open_material(lua_State *L);
 /* add_body's material and force_threshold keys (the material stays referenced by the table at arg). */
 void clua_read_material_keys(lua_State *L, int arg, const char *fname, carom_body_def *d);
+/* The live body at arg: its world (raises naming the argument when the body
+ * or its world is gone) and its id (wrap_game.c). */
+carom_world *clua_check_body_id(lua_State *L, int arg, const char *fname, carom_body_id *id);
 /* The carom.Material at arg. */
 const carom_material *clua_check_material(lua_State *L, int arg, const char *fname);
 

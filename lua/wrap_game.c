@@ -13,7 +13,7 @@
 
 /* ---- bodies ------------------------------------------------------------------ */
 
-static carom_world *game_check_body(lua_State *L, int arg, const char *fname, carom_body_id *id)
+carom_world *clua_check_body_id(lua_State *L, int arg, const char *fname, carom_body_id *id)
 {
     clua_body *b = luaL_testudata(L, arg, CLUA_BODY_MT);
     if (!b) clua_type_error(L, arg, fname, CLUA_BODY_MT);
@@ -55,13 +55,13 @@ static int body_set_filter(lua_State *L)
 {
     static const char *const keys[] = {"category", "mask", "group", NULL};
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "set_filter", &id);
+    carom_world *w = clua_check_body_id(L, 1, "set_filter", &id);
     clua_check_table(L, 2, "set_filter");
     clua_check_keys(L, 2, "set_filter", keys);
     carom_body_def d = carom_body_def_default();
     carom_body_get_filter(w, id, &d.category, &d.mask, &d.group);
     clua_read_filter_keys(L, 2, "set_filter", &d);
-    w = game_check_body(L, 1, "set_filter", &id);
+    w = clua_check_body_id(L, 1, "set_filter", &id);
     carom_status st = carom_body_set_filter(w, id, d.category, d.mask, d.group);
     if (st != CAROM_OK) {
         char buf[256];
@@ -74,7 +74,7 @@ static int body_set_filter(lua_State *L)
 static int body_filter(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "filter", &id);
+    carom_world *w = clua_check_body_id(L, 1, "filter", &id);
     uint64_t c = 0, m = 0;
     int g = 0;
     carom_body_get_filter(w, id, &c, &m, &g);
@@ -293,8 +293,8 @@ static int world_distance(lua_State *L)
     const char *fname = "distance";
     clua_world *lw = clua_check_world(L, 1, fname);
     carom_body_id a, b;
-    carom_world *wa = game_check_body(L, 2, fname, &a);
-    carom_world *wb = game_check_body(L, 3, fname, &b);
+    carom_world *wa = clua_check_body_id(L, 2, fname, &a);
+    carom_world *wb = clua_check_body_id(L, 3, fname, &b);
     if (wa != lw->world) clua_arg_error(L, 2, fname, "body belongs to another world");
     if (wb != lw->world) clua_arg_error(L, 3, fname, "body belongs to another world");
     carom_distance_result r;
@@ -321,10 +321,10 @@ static int game_status(lua_State *L, carom_world *w, carom_status st, int arg, c
 static int body_apply_angular_impulse(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "apply_angular_impulse", &id);
+    carom_world *w = clua_check_body_id(L, 1, "apply_angular_impulse", &id);
     carom_vec3 v;
     clua_check_vec3(L, 2, "apply_angular_impulse", &v);
-    w = game_check_body(L, 1, "apply_angular_impulse", &id);
+    w = clua_check_body_id(L, 1, "apply_angular_impulse", &id);
     return game_status(L, w, carom_body_apply_angular_impulse(w, id, v), 2, "apply_angular_impulse");
 }
 
@@ -332,7 +332,7 @@ static int body_apply_angular_impulse(lua_State *L)
 static int body_set_damping(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "set_damping", &id);
+    carom_world *w = clua_check_body_id(L, 1, "set_damping", &id);
     double lin = clua_check_number(L, 2, "set_damping"), ang = clua_check_number(L, 3, "set_damping");
     carom_status st = carom_body_set_damping(w, id, lin, ang);
     if (st == CAROM_ERROR_INVALID_ARGUMENT) {
@@ -347,7 +347,7 @@ static int body_set_damping(lua_State *L)
 static int body_damping(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "damping", &id);
+    carom_world *w = clua_check_body_id(L, 1, "damping", &id);
     double lin = 0, ang = 0;
     carom_body_get_damping(w, id, &lin, &ang);
     lua_pushnumber(L, lin);
@@ -359,10 +359,10 @@ typedef carom_status convert_fn(const carom_world *, carom_body_id, carom_vec3, 
 static int convert(lua_State *L, const char *fname, convert_fn *fn)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, fname, &id);
+    carom_world *w = clua_check_body_id(L, 1, fname, &id);
     carom_vec3 in, out = {0, 0, 0};
     clua_check_vec3(L, 2, fname, &in);
-    w = game_check_body(L, 1, fname, &id);
+    w = clua_check_body_id(L, 1, fname, &id);
     game_status(L, w, fn(w, id, in, &out), 2, fname);
     return clua_return_vec3(L, out);
 }
@@ -375,7 +375,7 @@ static int body_local_vector(lua_State *L) { return convert(L, "local_vector", c
 static int body_shape(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "shape", &id);
+    carom_world *w = clua_check_body_id(L, 1, "shape", &id);
     carom_shape_def d;
     carom_body_get_shape(w, id, &d);
     clua_shape *s = lua_newuserdatauv(L, sizeof *s, 0);
@@ -394,7 +394,7 @@ static int body_shape(lua_State *L)
 static int body_previous_position(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "previous_position", &id);
+    carom_world *w = clua_check_body_id(L, 1, "previous_position", &id);
     carom_vec3 p = {0, 0, 0};
     carom_body_get_previous_position(w, id, &p);
     return clua_return_vec3(L, p);
@@ -403,7 +403,7 @@ static int body_previous_position(lua_State *L)
 static int body_previous_orientation(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "previous_orientation", &id);
+    carom_world *w = clua_check_body_id(L, 1, "previous_orientation", &id);
     carom_quat q = {1, 0, 0, 0};
     carom_body_get_previous_orientation(w, id, &q);
     lua_pushnumber(L, q.w);
@@ -418,7 +418,7 @@ static int body_previous_orientation(lua_State *L)
 static int body_is_sensor(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "is_sensor", &id);
+    carom_world *w = clua_check_body_id(L, 1, "is_sensor", &id);
     lua_pushboolean(L, carom_body_is_sensor(w, id));
     return 1;
 }
@@ -428,11 +428,11 @@ static int body_is_sensor(lua_State *L)
 static int body_contacts(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = game_check_body(L, 1, "contacts", &id);
+    carom_world *w = clua_check_body_id(L, 1, "contacts", &id);
     int n = carom_body_get_contacts(w, id, NULL, 0);
     if (n < 0) n = 0;
     carom_contact_info *info = lua_newuserdatauv(L, sizeof *info * (size_t)(n > 0 ? n : 1), 0);
-    w = game_check_body(L, 1, "contacts", &id);
+    w = clua_check_body_id(L, 1, "contacts", &id);
     int got = carom_body_get_contacts(w, id, info, n);
     if (got > n) got = n;
     lua_getiuservalue(L, 1, BODY_UV_WORLD);

@@ -68,19 +68,6 @@ static int material_tostring(lua_State *L)
 
 /* ---- body calls --------------------------------------------------------------------- */
 
-static carom_world *material_check_body(lua_State *L, int arg, const char *fname, carom_body_id *id)
-{
-    clua_body *b = luaL_testudata(L, arg, CLUA_BODY_MT);
-    if (!b) clua_type_error(L, arg, fname, CLUA_BODY_MT);
-    lua_getiuservalue(L, arg, BODY_UV_WORLD);
-    clua_world *lw = luaL_testudata(L, -1, CLUA_WORLD_MT);
-    lua_pop(L, 1);
-    if (!lw || !lw->world) clua_arg_error(L, arg, fname, "the body's world has been destroyed");
-    if (!carom_body_is_valid(lw->world, b->id)) clua_arg_error(L, arg, fname, "body has been destroyed");
-    *id = b->id;
-    return lw->world;
-}
-
 static int status_result(lua_State *L, carom_world *w, carom_status st, int arg, const char *fname)
 {
     if (st == CAROM_OK) return 0;
@@ -95,10 +82,10 @@ static int status_result(lua_State *L, carom_world *w, carom_status st, int arg,
 static int body_apply_torque(lua_State *L)
 {
     carom_body_id id;
-    material_check_body(L, 1, "apply_torque", &id);
+    clua_check_body_id(L, 1, "apply_torque", &id);
     carom_vec3 t;
     clua_check_vec3(L, 2, "apply_torque", &t);
-    carom_world *w = material_check_body(L, 1, "apply_torque", &id); /* again: the checks may have run a finalizer */
+    carom_world *w = clua_check_body_id(L, 1, "apply_torque", &id); /* again: the checks may have run a finalizer */
     return status_result(L, w, carom_body_apply_torque(w, id, t), 2, "apply_torque");
 }
 
@@ -107,12 +94,12 @@ static int body_apply_torque(lua_State *L)
 static int body_apply_force(lua_State *L)
 {
     carom_body_id id;
-    material_check_body(L, 1, "apply_force", &id);
+    clua_check_body_id(L, 1, "apply_force", &id);
     carom_vec3 f, p;
     int next = clua_check_vec3(L, 2, "apply_force", &f);
     int at_point = !lua_isnoneornil(L, next);
     if (at_point) clua_check_vec3(L, next, "apply_force", &p);
-    carom_world *w = material_check_body(L, 1, "apply_force", &id);
+    carom_world *w = clua_check_body_id(L, 1, "apply_force", &id);
     carom_status st = at_point ? carom_body_apply_force_at_point(w, id, f, p) : carom_body_apply_force(w, id, f);
     return status_result(L, w, st, 2, "apply_force");
 }
@@ -121,7 +108,7 @@ static int body_apply_force(lua_State *L)
 static int body_applied_force(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = material_check_body(L, 1, "applied_force", &id);
+    carom_world *w = clua_check_body_id(L, 1, "applied_force", &id);
     carom_vec3 f = {0, 0, 0}, t = {0, 0, 0};
     carom_body_get_applied_force(w, id, &f, &t);
     clua_push_vec3_table(L, f);
@@ -132,16 +119,16 @@ static int body_applied_force(lua_State *L)
 static int body_set_force_threshold(lua_State *L)
 {
     carom_body_id id;
-    material_check_body(L, 1, "set_force_threshold", &id);
+    clua_check_body_id(L, 1, "set_force_threshold", &id);
     double v = clua_check_number(L, 2, "set_force_threshold");
-    carom_world *w = material_check_body(L, 1, "set_force_threshold", &id);
+    carom_world *w = clua_check_body_id(L, 1, "set_force_threshold", &id);
     return status_result(L, w, carom_body_set_force_threshold(w, id, v), 2, "set_force_threshold");
 }
 
 static int body_force_threshold(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = material_check_body(L, 1, "force_threshold", &id);
+    carom_world *w = clua_check_body_id(L, 1, "force_threshold", &id);
     double v = 0;
     carom_body_get_force_threshold(w, id, &v);
     lua_pushnumber(L, v);
@@ -151,16 +138,16 @@ static int body_force_threshold(lua_State *L)
 static int body_set_material(lua_State *L)
 {
     carom_body_id id;
-    material_check_body(L, 1, "set_material", &id);
+    clua_check_body_id(L, 1, "set_material", &id);
     const carom_material *m = clua_check_material(L, 2, "set_material");
-    carom_world *w = material_check_body(L, 1, "set_material", &id);
+    carom_world *w = clua_check_body_id(L, 1, "set_material", &id);
     return status_result(L, w, carom_body_set_material(w, id, m), 2, "set_material");
 }
 
 static int body_material(lua_State *L)
 {
     carom_body_id id;
-    carom_world *w = material_check_body(L, 1, "material", &id);
+    carom_world *w = clua_check_body_id(L, 1, "material", &id);
     carom_material m = carom_material_default();
     carom_body_get_material(w, id, &m);
     push_material(L, &m);
