@@ -257,20 +257,28 @@ static void put_coded(writer *o, const double *v, const double *pred, int n)
     int tag[CODED_MAX];
     for (int i = 0; i < n; i++) {
         x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
-        int lead = 0, trail = 0;
-        while (lead < 8 && !((x[i] >> (56 - 8 * lead)) & 0xff)) lead++;
-        while (trail < 8 && !((x[i] >> (8 * trail)) & 0xff)) trail++;
+        if (x[i] == 0) { tag[i] = 0; continue; }
+        int lead, trail;
+#if defined(__GNUC__)
+        lead = __builtin_clzll(x[i]) / 8;
+        trail = __builtin_ctzll(x[i]) / 8;
+#else
+        lead = trail = 0;
+        while (!((x[i] >> (56 - 8 * lead)) & 0xff)) lead++;
+        while (!((x[i] >> (8 * trail)) & 0xff)) trail++;
+#endif
         if (lead == 8) tag[i] = 0;
         else if (trail > 0 && trail > lead) tag[i] = 8 + trail; /* keep the high 8 - trail bytes */
         else tag[i] = 8 - lead;                                 /* keep the low 8 - lead bytes */
     }
-    for (int i = 0; i < n; i += 2) put_u8(o, (unsigned)tag[i] | (i + 1 < n ? (unsigned)tag[i + 1] << 4 : 0u));
+    unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX];
+    size_t len = 0;
+    for (int i = 0; i < n; i += 2) bytes[len++] = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
     for (int i = 0; i < n; i++) {
-        if (tag[i] <= 8)
-            for (int k = 0; k < tag[i]; k++) put_u8(o, (unsigned)(x[i] >> (8 * k)) & 0xffu);
-        else
-            for (int k = tag[i] - 8; k < 8; k++) put_u8(o, (unsigned)(x[i] >> (8 * k)) & 0xffu);
+        int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
+        for (int k = from; k < to; k++) bytes[len++] = (unsigned char)(x[i] >> (8 * k));
     }
+    put_bytes(o, bytes, len);
 }
 
 /* The reader's side; every value decoded must be finite. */
@@ -283,12 +291,17 @@ static void get_coded(reader *r, double *out, const double *pred, int n, const c
         if (i + 1 < n) tag[i + 1] = (int)(b >> 4);
         else if (b >> 4 && !r->failed) bad(r, "%s: unused tag bits set", what);
     }
+    size_t total = 0;
+    for (int i = 0; i < n; i++) total += (size_t)(tag[i] <= 8 ? tag[i] : 16 - tag[i]);
+    if (r->failed || !need(r, total, what)) {
+        for (int i = 0; i < n; i++) out[i] = 0;
+        return;
+    }
     for (int i = 0; i < n; i++) {
         out[i] = 0;
         if (r->failed) continue;
         uint64_t x = 0;
         int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
-        if (!need(r, (size_t)(to - from), what)) continue;
         for (int k = from; k < to; k++) x |= (uint64_t)r->buf[r->pos++] << (8 * k);
         uint64_t bits = x ^ f64_bits(pred[i]);
         memcpy(&out[i], &bits, 8);
@@ -866,7 +879,7 @@ enum {
     REC_SLEEP_TIME = 64, REC_PREVIOUS = 128, REC_FAT = 256, REC_TORQUE = 512
 };
 
-static void write_bodies(writer *o, const carom_world *w, const class_table *t)
+static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
 {
     const body_store *s = &w->bodies;
     put_varint(o, (uint64_t)t->count);
@@ -876,7 +889,7 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t)
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
     for (int i = 0; i < s->count; i++) {
-        xform x = body_xform(s, i);
+        xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
         int same_fat = same_bits(&fat, &s->fat_box[i], sizeof fat);
         int same_previous = same_bits(&x.p, &s->previous_origin[i], sizeof x.p) &&
@@ -918,6 +931,16 @@ enum { CREC_HAS_NORMAL = 8, CREC_FLIP = 16, CREC_SUB = 32, CREC_SUB_LIMIT = 64, 
        CREC_NORMAL = 512, CREC_CACHE_NORMAL = 1024, CREC_MATERIAL = 2048, CREC_POSE = 4096, CREC_REACH = 8192,
        CREC_NORMAL_A = 16384, CREC_ALL = 32767 };
 
+/* The friction basis the solver starts from for a normal (solver.c): the
+ * kept basis of a resting contact is usually this, to the last bits. */
+static vec3 basis_guess(vec3 n)
+{
+    if (v3_is_zero(n)) return n;
+    vec3 t1, t2;
+    v3_basis(n, &t1, &t2);
+    return v3_normalize(t1);
+}
+
 /* A manifold normal is read while the pair touches, or touched last step (its
  * end event); otherwise the next collision test rewrites it before anything
  * reads it (collision.c), so it is not state and is not written. */
@@ -932,17 +955,17 @@ typedef struct contact_guess {
     double friction, restitution;
 } contact_guess;
 
-static contact_guess guess_contact(const body_store *s, int a, int b)
+static contact_guess guess_contact(const body_store *s, const xform *pose, int a, int b)
 {
     contact_guess g;
-    g.xa = body_xform(s, a);
-    g.xb = body_xform(s, b);
+    g.xa = pose[a];
+    g.xb = pose[b];
     g.friction = sqrt(s->friction[a] * s->friction[b]);
     g.restitution = dmax(s->restitution[a], s->restitution[b]);
     return g;
 }
 
-static void write_contacts(writer *o, const carom_world *w)
+static void write_contacts(writer *o, const carom_world *w, const xform *pose)
 {
     const body_store *s = &w->bodies;
     const contact_set *cs = &w->contacts;
@@ -952,14 +975,14 @@ static void write_contacts(writer *o, const carom_world *w)
         const contact *c = &cs->items[i];
         const contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        contact_guess g = guess_contact(s, a, b);
+        contact_guess g = guess_contact(s, pose, a, b);
         /* what the reader will hold, and predict from */
         vec3 normal = normal_is_state(c, d) ? d->m.normal : v3(0, 0, 0);
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
         int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
-        xform rel = relative_pose(g.xa, g.xb);
-        double reach = shape_bounding_radius(&s->shapes[b]);
-        vec3 normal_a = q_inv_rotate(g.xa.q, normal);
+        xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
+        double reach = (c->flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[b]) : 0.0;
+        vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
         unsigned bits = (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
                         (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
                         (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
@@ -985,7 +1008,7 @@ static void write_contacts(writer *o, const carom_world *w)
             double v[3] = {d->friction, d->restitution, d->rolling_resistance}, p[3] = {g.friction, g.restitution, 0};
             put_coded(o, v, p, 3);
         }
-        if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, v3(0, 0, 0));
+        if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, basis_guess(c->cache.normal));
         /* only what the collision stage reads under each flag (collision.c):
          * the pose and gap of a pair known apart, the pose and normal of a
          * manifold it may reuse */
@@ -1014,7 +1037,7 @@ static void write_contacts(writer *o, const carom_world *w)
     }
 }
 
-static void write_world(writer *o, const carom_world *w, const class_table *t)
+static void write_world(writer *o, const carom_world *w, const class_table *t, const xform *pose)
 {
     const body_store *s = &w->bodies;
     write_def(o, &w->def);
@@ -1028,8 +1051,8 @@ static void write_world(writer *o, const carom_world *w, const class_table *t)
         put_varint(o, s->ids[i].generation);
         put_varint(o, (uint64_t)(s->ids[i].next_free + 1));
     }
-    write_bodies(o, w, t);
-    write_contacts(o, w);
+    write_bodies(o, w, t, pose);
+    write_contacts(o, w, pose);
     /* the sensors' overlaps after the last step (sensor.c): their next events */
     put_varint(o, (uint64_t)w->sensor_overlap_count);
     for (int i = 0; i < w->sensor_overlap_count; i++) {
@@ -1046,10 +1069,14 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
         return 0;
     }
     class_table t;
-    if (!build_classes(&w->bodies, &t)) {
+    int n = w->bodies.count;
+    xform *pose = malloc(sizeof *pose * (size_t)(n > 0 ? n : 1));
+    if (!pose || !build_classes(&w->bodies, &t)) {
+        free(pose);
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "world_snapshot: out of memory");
         return 0;
     }
+    for (int i = 0; i < n; i++) pose[i] = body_xform(&w->bodies, i);
     if (!buf) capacity = 0;
     writer o = {buf, capacity, 0};
     put_bytes(&o, SNAP_MAGIC, 8);
@@ -1057,8 +1084,9 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
     put_u32(&o, SNAP_HEADER_SIZE);
     put_u64(&o, 0); /* total size, filled below */
     put_u64(&o, 0); /* checksum, filled below */
-    write_world(&o, w, &t);
+    write_world(&o, w, &t, pose);
     class_table_free(&t);
+    free(pose);
     if (o.pos <= capacity) {
         writer h = {buf, capacity, 16};
         put_u64(&h, (uint64_t)o.pos);
@@ -1320,7 +1348,7 @@ static int read_sensor_overlaps(reader *r, carom_world *w)
     return 1;
 }
 
-static int read_contacts(reader *r, carom_world *w)
+static int read_contacts(reader *r, carom_world *w, const xform *pose)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
@@ -1355,7 +1383,7 @@ static int read_contacts(reader *r, carom_world *w)
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
-        contact_guess g = guess_contact(s, sa, sb);
+        contact_guess g = guess_contact(s, pose, sa, sb);
         c->flags = flags;
         c->sub_limit = sub_limit;
         c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
@@ -1373,7 +1401,7 @@ static int read_contacts(reader *r, carom_world *w)
         d->friction = material[0];
         d->restitution = material[1];
         d->rolling_resistance = material[2];
-        d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, v3(0, 0, 0), "friction basis") : v3(0, 0, 0);
+        d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis") : v3(0, 0, 0);
         if (posed) {
             xform rel = relative_pose(g.xa, g.xb);
             c->rel_pose.p = (bits & CREC_POSE) ? get_coded_v3(r, rel.p, "contact pose") : rel.p;
@@ -1450,7 +1478,20 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (!w) return bad(&r, "out of memory"), NULL;
     w->def.body_capacity = capacity_hint;
     w->stats.step_count = (long long)steps;
-    if (!read_bodies(&r, w) || !read_contacts(&r, w) || !read_sensor_overlaps(&r, w)) {
+    if (!read_bodies(&r, w)) {
+        carom_world_destroy(w);
+        return NULL;
+    }
+    body_store *s = &w->bodies;
+    xform *pose = malloc(sizeof *pose * (size_t)(s->count > 0 ? s->count : 1));
+    if (!pose) {
+        carom_world_destroy(w);
+        return bad(&r, "out of memory"), NULL;
+    }
+    for (int i = 0; i < s->count; i++) pose[i] = body_xform(s, i);
+    int ok = read_contacts(&r, w, pose) && read_sensor_overlaps(&r, w);
+    free(pose);
+    if (!ok) {
         carom_world_destroy(w);
         return NULL;
     }
@@ -1459,7 +1500,6 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
         return bad(&r, "%zu bytes left over after the sensor overlaps", size - r.pos), NULL;
     }
     /* the broadphase, rebuilt from the stored bounds in slot order, with the moved set restored */
-    body_store *s = &w->bodies;
     for (int i = 0; i < s->count; i++) {
         s->proxy[i] = bp_create_proxy(w->bp, s->fat_box[i], s->type[i] == CAROM_BODY_STATIC, s->id_index[i]);
         if (s->proxy[i] < 0) {
