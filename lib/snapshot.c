@@ -219,7 +219,11 @@ static uint64_t get_varint(reader *r, const char *what)
         if (r->failed) return 0;
         if (shift == 63 && b > 1) break;
         v |= (uint64_t)(b & 0x7f) << shift;
-        if (!(b & 0x80)) return v;
+        if (!(b & 0x80)) {
+            /* one encoding per value, so a restored world snapshots back to the same bytes */
+            if (b == 0 && shift > 0) { bad(r, "%s: varint with a needless byte", what); return 0; }
+            return v;
+        }
     }
     bad(r, "%s: varint longer than 64 bits", what);
     return 0;
@@ -251,25 +255,31 @@ static uint64_t f64_bits(double d)
  * payloads: 0 equal to the prediction; 1..8 the XOR's low t bytes (its high
  * bytes are zero); 9..15 its high 16 - t bytes (its low t - 8 bytes are zero). */
 #define CODED_MAX 8
+
+/* The one tag the writer picks for an XOR (the reader refuses any other). */
+static int coded_tag(uint64_t x)
+{
+    if (x == 0) return 0;
+    int lead, trail;
+#if defined(__GNUC__)
+    lead = __builtin_clzll(x) / 8;
+    trail = __builtin_ctzll(x) / 8;
+#else
+    lead = trail = 0;
+    while (!((x >> (56 - 8 * lead)) & 0xff)) lead++;
+    while (!((x >> (8 * trail)) & 0xff)) trail++;
+#endif
+    if (trail > 0 && trail > lead) return 8 + trail; /* keep the high 8 - trail bytes */
+    return 8 - lead;                                 /* keep the low 8 - lead bytes */
+}
+
 static void put_coded(writer *o, const double *v, const double *pred, int n)
 {
     uint64_t x[CODED_MAX];
     int tag[CODED_MAX];
     for (int i = 0; i < n; i++) {
         x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
-        if (x[i] == 0) { tag[i] = 0; continue; }
-        int lead, trail;
-#if defined(__GNUC__)
-        lead = __builtin_clzll(x[i]) / 8;
-        trail = __builtin_ctzll(x[i]) / 8;
-#else
-        lead = trail = 0;
-        while (!((x[i] >> (56 - 8 * lead)) & 0xff)) lead++;
-        while (!((x[i] >> (8 * trail)) & 0xff)) trail++;
-#endif
-        if (lead == 8) tag[i] = 0;
-        else if (trail > 0 && trail > lead) tag[i] = 8 + trail; /* keep the high 8 - trail bytes */
-        else tag[i] = 8 - lead;                                 /* keep the low 8 - lead bytes */
+        tag[i] = coded_tag(x[i]);
     }
     unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX];
     size_t len = 0;
@@ -303,6 +313,7 @@ static void get_coded(reader *r, double *out, const double *pred, int n, const c
         uint64_t x = 0;
         int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
         for (int k = from; k < to; k++) x |= (uint64_t)r->buf[r->pos++] << (8 * k);
+        if (coded_tag(x) != tag[i]) { bad(r, "%s: a coded double not in its shortest form", what); continue; }
         uint64_t bits = x ^ f64_bits(pred[i]);
         memcpy(&out[i], &bits, 8);
         if (!isfinite(out[i])) bad(r, "%s is not finite", what);
@@ -539,8 +550,13 @@ static hull *read_hull(reader *r)
             bad(r, "hull face %d has %d vertices from index %d, of %d", f, hf->count, hf->first, nfv);
         if (!r->failed && fabs(v3_len(hf->normal) - 1.0) > 1e-6) bad(r, "hull face %d normal is not unit", f);
     }
-    int total = 0;
-    for (int f = 0; f < nf && !r->failed; f++) total += h->faces[f].count;
+    int total = 0, used = 0;
+    for (int f = 0; f < nf && !r->failed; f++) {
+        total += h->faces[f].count;
+        if (h->faces[f].first + h->faces[f].count > used) used = h->faces[f].first + h->faces[f].count;
+    }
+    /* the writer writes exactly the face vertices the faces use */
+    if (!r->failed && used != nfv) bad(r, "hull has %d face vertices, its faces use %d", nfv, used);
     if (!r->failed && total > HULL_MAX_FACE_VERTICES) bad(r, "hull faces hold %d vertices, at most %d", total, HULL_MAX_FACE_VERTICES);
     for (int i = 0; i < nfv && !r->failed; i++) {
         h->face_vertices[i] = get_i32(r, "hull face vertex");
@@ -879,6 +895,19 @@ enum {
     REC_SLEEP_TIME = 64, REC_PREVIOUS = 128, REC_FAT = 256, REC_TORQUE = 512
 };
 
+/* A body's record bits, from its state: the writer's, and what the reader
+ * checks it read (one encoding per state). */
+static unsigned body_bits(const body_store *s, int i, xform x, aabb fat, int moved)
+{
+    int same_fat = same_bits(&fat, &s->fat_box[i], sizeof fat);
+    int same_previous = same_bits(&x.p, &s->previous_origin[i], sizeof x.p) && same_bits(&x.q, &s->previous_rotation[i], sizeof x.q);
+    return ((s->flags[i] & BODY_AWAKE) ? REC_AWAKE : 0) | ((s->flags[i] & BODY_HAS_FORCE) ? REC_FORCE_FLAG : 0) |
+           (moved ? REC_MOVED : 0) | (v3_is_zero(s->velocity[i]) ? 0 : REC_VELOCITY) |
+           (v3_is_zero(s->angular_velocity[i]) ? 0 : REC_SPIN) | (v3_is_zero(s->force[i]) ? 0 : REC_FORCE) |
+           (f64_bits(s->sleep_time[i]) == 0 ? 0 : REC_SLEEP_TIME) | (same_previous ? 0 : REC_PREVIOUS) |
+           (same_fat ? 0 : REC_FAT) | (v3_is_zero(s->torque[i]) ? 0 : REC_TORQUE);
+}
+
 static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
 {
     const body_store *s = &w->bodies;
@@ -891,14 +920,7 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t, 
     for (int i = 0; i < s->count; i++) {
         xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
-        int same_fat = same_bits(&fat, &s->fat_box[i], sizeof fat);
-        int same_previous = same_bits(&x.p, &s->previous_origin[i], sizeof x.p) &&
-                            same_bits(&x.q, &s->previous_rotation[i], sizeof x.q);
-        unsigned bits = ((s->flags[i] & BODY_AWAKE) ? REC_AWAKE : 0) | ((s->flags[i] & BODY_HAS_FORCE) ? REC_FORCE_FLAG : 0) |
-                        (bp_is_moved(w->bp, s->proxy[i]) ? REC_MOVED : 0) | (v3_is_zero(s->velocity[i]) ? 0 : REC_VELOCITY) |
-                        (v3_is_zero(s->angular_velocity[i]) ? 0 : REC_SPIN) | (v3_is_zero(s->force[i]) ? 0 : REC_FORCE) |
-                        (f64_bits(s->sleep_time[i]) == 0 ? 0 : REC_SLEEP_TIME) | (same_previous ? 0 : REC_PREVIOUS) |
-                        (same_fat ? 0 : REC_FAT) | (v3_is_zero(s->torque[i]) ? 0 : REC_TORQUE);
+        unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]));
         put_varint(o, bits);
         put_varint(o, (uint64_t)t->of_body[i]);
         put_coded_v3(o, s->center[i], last_center);
@@ -965,6 +987,25 @@ static contact_guess guess_contact(const body_store *s, const xform *pose, int a
     return g;
 }
 
+/* A contact's record bits, from its state and the reader's predictions. */
+static unsigned contact_bits(const contact *c, const contact_data *d, const contact_guess *gp, vec3 normal, vec3 cache_guess,
+                             xform rel, double reach, vec3 normal_a)
+{
+    contact_guess g = *gp;
+    int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
+    return (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
+                        (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
+                        (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
+                        (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
+                        (f64_bits(d->friction) == f64_bits(g.friction) && f64_bits(d->restitution) == f64_bits(g.restitution) &&
+                                    f64_bits(d->rolling_resistance) == 0
+                             ? 0 : CREC_MATERIAL) |
+                        (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
+                             ? CREC_POSE : 0) |
+                        ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
+                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, &normal_a, sizeof normal_a) ? CREC_NORMAL_A : 0);
+}
+
 static void write_contacts(writer *o, const carom_world *w, const xform *pose)
 {
     const body_store *s = &w->bodies;
@@ -983,17 +1024,7 @@ static void write_contacts(writer *o, const carom_world *w, const xform *pose)
         xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
         double reach = (c->flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[b]) : 0.0;
         vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
-        unsigned bits = (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
-                        (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
-                        (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
-                        (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
-                        (f64_bits(d->friction) == f64_bits(g.friction) && f64_bits(d->restitution) == f64_bits(g.restitution) &&
-                                    f64_bits(d->rolling_resistance) == 0
-                             ? 0 : CREC_MATERIAL) |
-                        (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
-                             ? CREC_POSE : 0) |
-                        ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
-                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, &normal_a, sizeof normal_a) ? CREC_NORMAL_A : 0);
+        unsigned bits = contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a);
         put_varint(o, zigzag((int64_t)c->id_a - last_a));
         put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
         last_a = c->id_a;
@@ -1107,12 +1138,14 @@ typedef struct body_class {
     int group, combine;
     double force_threshold, rolling_resistance;
     size_t shape_at;        /* where its shape starts in the snapshot */
+    size_t start, end;      /* its bytes */
 } body_class;
 
 /* One class, checked as the API checks a body def; its shape is read (and
  * checked) here and again, from shape_at, for every body of the class. */
 static int read_class(reader *r, body_class *k)
 {
+    k->start = r->pos;
     k->type = (int)get_u8(r, "class type");
     k->flags = get_u32(r, "class flags");
     k->local_center = get_v3(r, "class centre of mass");
@@ -1160,6 +1193,7 @@ static int read_class(reader *r, body_class *k)
     shape sh;
     int ok = read_shape(r, &sh, type, 0);
     shape_free_data(&sh);
+    k->end = r->pos;
     return ok;
 }
 
@@ -1212,6 +1246,30 @@ static int check_ids(reader *r, body_store *s, int count)
     return 1;
 }
 
+/* The writer merges equal classes: two equal ones are not its output. */
+static int distinct_classes(reader *r, const body_class *k, int n)
+{
+    int cap = 16;
+    while (cap < 2 * n) cap *= 2;
+    int *slots = malloc(sizeof *slots * (size_t)cap);
+    if (!slots) return bad(r, "out of memory");
+    for (int i = 0; i < cap; i++) slots[i] = -1;
+    for (int c = 0; c < n; c++) {
+        size_t len = k[c].end - k[c].start;
+        int h = (int)(hash_bytes(r->buf + k[c].start, len) & (uint64_t)(cap - 1));
+        for (; slots[h] >= 0; h = (h + 1) & (cap - 1)) {
+            const body_class *o = &k[slots[h]];
+            if (o->end - o->start == len && memcmp(r->buf + o->start, r->buf + k[c].start, len) == 0) {
+                free(slots);
+                return bad(r, "body classes %d and %d are the same", slots[h], c);
+            }
+        }
+        slots[h] = c;
+    }
+    free(slots);
+    return 1;
+}
+
 static int read_bodies(reader *r, carom_world *w)
 {
     body_store *s = &w->bodies;
@@ -1223,6 +1281,7 @@ static int read_bodies(reader *r, carom_world *w)
     if (!classes) return bad(r, "out of memory");
     for (int k = 0; k < class_count; k++)
         if (!read_class(r, &classes[k])) { free(classes); return 0; }
+    if (!distinct_classes(r, classes, class_count)) { free(classes); return 0; }
     int count = get_small(r, 0, s->id_count, 0, "body count");
     if (r->failed || (size_t)count * 6 > r->size - r->pos) { /* the shortest body record */
         free(classes);
@@ -1244,12 +1303,16 @@ static int read_bodies(reader *r, carom_world *w)
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
+    int classes_used = 0;
     for (int i = 0; i < count; i++) {
         char what[48];
         snprintf(what, sizeof what, "body %d", i);
         int bits = get_small(r, 0, 1023, 0, what);
         int ci = get_small(r, 0, class_count - 1, 0, what);
         if (r->failed) break;
+        /* classes come in the order bodies first use them, each used */
+        if (ci > classes_used) { bad(r, "body %d uses class %d before class %d", i, ci, classes_used); break; }
+        if (ci == classes_used) classes_used++;
         const body_class *k = &classes[ci];
         if (k->type == CAROM_BODY_STATIC && (bits & REC_AWAKE)) { bad(r, "static body %d is awake", i); break; }
         s->type[i] = k->type;
@@ -1314,6 +1377,10 @@ static int read_bodies(reader *r, carom_world *w)
         s->previous_rotation[i] = (bits & REC_PREVIOUS) ? get_coded_q(r, x.q, what) : x.q;
         if (r->failed) break;
         if (!(fat.lo.x <= fat.hi.x && fat.lo.y <= fat.hi.y && fat.lo.z <= fat.hi.z)) { bad(r, "body %d bounds are inverted", i); break; }
+        if (body_bits(s, i, x, predicted_fat_box(w, i), s->solver_index[i]) != (unsigned)bits) {
+            bad(r, "body %d: its record bits do not match its fields (a field equal to its prediction written)", i);
+            break;
+        }
         /* derived fields, computed as body creation and the setters compute them */
         int dynamic = k->type == CAROM_BODY_DYNAMIC;
         s->inv_mass[i] = dynamic ? 1.0 / s->mass[i] : 0.0;
@@ -1321,6 +1388,7 @@ static int read_bodies(reader *r, carom_world *w)
         body_update_inertia(s, i);
     }
     free(classes);
+    if (!r->failed && classes_used != class_count) bad(r, "%d of %d body classes unused", class_count - classes_used, class_count);
     return !r->failed;
 }
 
@@ -1417,6 +1485,13 @@ static int read_contacts(reader *r, carom_world *w, const xform *pose)
             d->normal_a = (bits & CREC_NORMAL_A) ? get_coded_v3(r, normal_a, "contact normal") : normal_a;
         }
         if (r->failed) return 0;
+        {
+            xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
+            double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
+            vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
+            if (contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) != (unsigned)bits)
+                return bad(r, "contact %d: its record bits do not match its fields", i);
+        }
         if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
               d->rolling_resistance >= 0 && d->rolling_resistance <= RANGE_FRICTION_MAX))
             return bad(r, "contact %d material out of range", i);

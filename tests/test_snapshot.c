@@ -314,6 +314,11 @@ static void test_bad_snapshots_refused(void **state)
         carom_world *r = carom_world_restore(copy, s.size, msg, sizeof msg);
         if (!r) { refused++; assert_true(strlen(msg) > 12); continue; }
         accepted++;
+        /* one encoding per state: what was accepted snapshots back to exactly its bytes */
+        snap again = take(r);
+        if (again.size != s.size || memcmp(again.data, copy, s.size) != 0)
+            fail_msg("flip trial %d: an accepted snapshot does not snapshot back to its own bytes", t);
+        free(again.data);
         for (int k = 0; k < 3; k++) assert_int_equal(carom_world_step(r, 1.0 / 60), CAROM_OK);
         carom_world_destroy(r);
     }
