@@ -13,6 +13,15 @@
  * not NULL. */
 quat rotation_free_step(quat q, const mat3 *inv_inertia_local, vec3 L, double h, vec3 *omega_mid);
 
+/* 1 when the body-frame inverse inertia is c Id (a sphere, a cube): then
+ * (I w) x w = 0, w = I^-1 L is constant and the midpoint step is the plain
+ * update with it, so the step skips the solve. */
+static inline int rotation_is_isotropic(const mat3 *m)
+{
+    return m->c0.y == 0.0 && m->c0.z == 0.0 && m->c1.x == 0.0 && m->c1.z == 0.0 && m->c2.x == 0.0 &&
+           m->c2.y == 0.0 && m->c0.x == m->c1.y && m->c1.y == m->c2.z;
+}
+
 /* The alternatives measured beside it (bench/rotation_methods.c):
  * ROTATION_CARRY_L: rotate about the current world w, then w = I_new^-1 L
  *   (what the step did before: L exact, energy grows ~ (w h)^2 per step);

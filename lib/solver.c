@@ -440,12 +440,14 @@ static void solve(carom_world *w, const step_context *ctx, const solver_work *wo
 
 /* Rotation over one sub-step: between impulses L = I w is what holds, so a
  * free body rotates with the midpoint w of Euler's equations (rotation.c);
- * the solver keeps w = I_start^-1 L for the step's impulses. Returns the
+ * the solver keeps w = I_start^-1 L for the step's impulses (a sphere's or
+ * a cube's w is constant between impulses: the plain update). Returns the
  * angular velocity the rotation used. */
 static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, const mat3 *inertia_start, double h)
 {
     vec3 wr = B->w;
-    if (B->inv_mass > 0.0 && !(bs->flags[slot] & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION))) {
+    if (B->inv_mass > 0.0 && !(bs->flags[slot] & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION)) &&
+        !rotation_is_isotropic(&bs->inv_inertia_local[slot])) {
         vec3 L = m3_mulv(*inertia_start, B->w);
         bs->rotation[slot] = rotation_free_step(bs->rotation[slot], &bs->inv_inertia_local[slot], L, h, &wr);
     } else if (B->inv_mass == 0.0) {
