@@ -1181,6 +1181,14 @@ static int read_class(reader *r, body_class *k)
             return bad(r, "a body class's mass %g is outside [1e-9, 1e15] kg", k->mass);
         if (!(trace <= RANGE_INERTIA_MAX && m3_det(I) / (trace * trace) >= RANGE_INERTIA_MIN))
             return bad(r, "a body class's inertia is outside [1e-24, 1e30] kg m^2");
+        /* an inertia tensor is symmetric with diagonal terms >= 0 and none
+         * above the trace (a fuzzed one with a term of -5e84 passed the two
+         * checks above and sent bodies to inf) */
+        double e[3][3] = {{I.c0.x, I.c0.y, I.c0.z}, {I.c1.x, I.c1.y, I.c1.z}, {I.c2.x, I.c2.y, I.c2.z}};
+        for (int u = 0; u < 3; u++)
+            for (int v = 0; v < 3; v++)
+                if (!(fabs(e[u][v]) <= trace && fabs(e[u][v] - e[v][u]) <= 1e-9 * trace && (u != v || e[u][v] >= 0)))
+                    return bad(r, "a body class's inertia is not a symmetric tensor");
     }
     if (!(k->mass >= 0) ||
         !(k->friction >= 0 && k->friction <= RANGE_FRICTION_MAX && k->restitution >= 0 && k->restitution <= 1 &&
