@@ -1268,8 +1268,9 @@ static int distinct_classes(reader *r, const body_class *k, int n)
         for (; slots[h] >= 0; h = (h + 1) & (cap - 1)) {
             const body_class *o = &k[slots[h]];
             if (o->end - o->start == len && memcmp(r->buf + o->start, r->buf + k[c].start, len) == 0) {
+                int same = slots[h];
                 free(slots);
-                return bad(r, "body classes %d and %d are the same", slots[h], c);
+                return bad(r, "body classes %d and %d are the same", same, c);
             }
         }
         slots[h] = c;
