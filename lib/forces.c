@@ -104,6 +104,11 @@ static double pair_threshold(double a, double b)
 void forces_raise_events(carom_world *w, const contact_constraint *constraints, int count, double dt)
 {
     const body_store *s = &w->bodies;
+    /* Most worlds set no threshold: one sequential pass over the bodies is
+     * cheaper than visiting every constraint's two bodies at random. */
+    int any = 0;
+    for (int i = 0; i < s->count && !any; i++) any = s->force_threshold[i] > 0;
+    if (!any) return;
     for (int k = 0; k < count; k++) {
         const contact_constraint *con = &constraints[k];
         const contact *c = &w->contacts.items[con->contact];
