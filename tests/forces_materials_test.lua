@@ -4,26 +4,8 @@
 -- presses with m g, a rolling ball slows at c g), and the errors of every
 -- new call. Run by `make check` with carom-run --test.
 local carom = require "carom"
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
-
-local function near(got, want, tol, what)
-  if type(got) ~= "number" or not (math.abs(got - want) <= tol) then
-    error(string.format("%s: got %s, expected %.12g (tolerance %g)", what or "value", tostring(got), want, tol), 2)
-  end
-end
-
-local function raises(text, fn, ...)
-  local ok, err = pcall(fn, ...)
-  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
-  if not tostring(err):find(text, 1, true) then
-    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
-  end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test, near, raises = T.test, T.near, T.raises
 
 test("apply_torque: a sphere spins up at tau / I", function()
   local w = carom.world{ gravity = {0, 0, 0} }
@@ -214,5 +196,4 @@ test("a force event's callback that errors or destroys the body", function()
   for _, e in ipairs(w2:events()) do assert(e.type ~= "force", "asleep: no force events") end
 end)
 
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()
