@@ -152,6 +152,7 @@ test: check
 
 check-c: $(TEST_BIN)
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; CAROM_ROOT=$(CURDIR) ./$$t 2>&1; done
+	@echo "== tests/no_circles.sh"; ./tests/no_circles.sh $(BUILD)/obj
 
 # Under SAN=1 the stand-alone lua5.4 loads the instrumented module with the
 # ASan runtime preloaded (it must come first); CAROM_LUA says how to start it.

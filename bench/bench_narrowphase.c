@@ -7,6 +7,7 @@
 #include <string.h>
 #include <time.h>
 #include "narrowphase.h"
+#include "compound.h"
 
 static double now_ns(void)
 {

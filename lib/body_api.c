@@ -10,6 +10,7 @@
 #include "ranges.h"
 #include "shape_def.h"
 #include "mesh.h"
+#include "body_motion.h"
 #include "deferred.h"
 #include "heightfield.h"
 #include "compound.h"
@@ -595,19 +596,7 @@ CAROM_API carom_status carom_body_set_linear_velocity(carom_world *w, carom_body
     GET_SLOT(w, id, "body_set_linear_velocity");
     if (w->in_callback) return world_defer_op(w, DEFER_LINEAR_VELOCITY, id, v, NULL, "body_set_linear_velocity");
     REQUIRE_UNLOCKED(w, "body_set_linear_velocity");
-    if (!finite_c(v)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_linear_velocity: velocity must be finite");
-    if (!speed_ok(v, w->def.max_linear_speed))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "body_set_linear_velocity: speed %g m/s is above the world's max_linear_speed %g m/s", len_c(v),
-                          w->def.max_linear_speed);
-    body_store *s = &w->bodies;
-    if (s->type[slot] == CAROM_BODY_STATIC)
-        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_linear_velocity: a static body cannot move");
-    vec3 nv = to_v3(v);
-    if (s->flags[slot] & BODY_LOCK_PLANE) nv = v3_madd(nv, -v3_dot(nv, s->plane_normal[slot]), s->plane_normal[slot]);
-    s->velocity[slot] = nv;
-    world_wake_body(w, slot);
-    return CAROM_OK;
+    return motion_set_linear_velocity(w, slot, v);
 }
 
 CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_body_id id, carom_vec3 av)
@@ -615,20 +604,7 @@ CAROM_API carom_status carom_body_set_angular_velocity(carom_world *w, carom_bod
     GET_SLOT(w, id, "body_set_angular_velocity");
     if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_VELOCITY, id, av, NULL, "body_set_angular_velocity");
     REQUIRE_UNLOCKED(w, "body_set_angular_velocity");
-    if (!finite_c(av)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_angular_velocity: must be finite");
-    if (!speed_ok(av, world_spin_limit(&w->def)))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "body_set_angular_velocity: speed %g rad/s is above the world's max_angular_speed %g rad/s",
-                          len_c(av), world_spin_limit(&w->def));
-    body_store *s = &w->bodies;
-    if (s->type[slot] == CAROM_BODY_STATIC)
-        return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_angular_velocity: a static body cannot move");
-    vec3 nw = to_v3(av);
-    if (s->flags[slot] & BODY_LOCK_ROTATION) nw = v3_zero();
-    if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
-    s->angular_velocity[slot] = nw;
-    world_wake_body(w, slot);
-    return CAROM_OK;
+    return motion_set_angular_velocity(w, slot, av);
 }
 
 CAROM_API carom_status carom_body_set_mass(carom_world *w, carom_body_id id, double mass)
@@ -758,34 +734,7 @@ CAROM_API carom_status carom_body_apply_impulse(carom_world *w, carom_body_id id
     GET_SLOT(w, id, "body_apply_impulse");
     if (w->in_callback) return world_defer_op(w, DEFER_IMPULSE, id, j, point, "body_apply_impulse");
     REQUIRE_UNLOCKED(w, "body_apply_impulse");
-    if (!finite_c(j)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: impulse must be finite");
-    if (point && !finite_c(*point)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: point must be finite");
-    body_store *s = &w->bodies;
-    if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK; /* infinite mass: no effect */
-    vec3 jv = to_v3(j);
-    vec3 dv = v3_scale(jv, s->inv_mass[slot]);
-    vec3 dw = v3_zero();
-    if (point) dw = m3_mulv(s->inv_inertia_world[slot], v3_cross(v3_sub(to_v3(*point), s->center[slot]), jv));
-    vec3 nv = v3_add(s->velocity[slot], dv), nw = v3_add(s->angular_velocity[slot], dw);
-    if (s->flags[slot] & BODY_LOCK_PLANE) {
-        vec3 n = s->plane_normal[slot];
-        nv = v3_madd(nv, -v3_dot(nv, n), n);
-        nw = v3_scale(n, v3_dot(nw, n));
-    }
-    if (!v3_is_finite(nv) || !v3_is_finite(nw))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_impulse: resulting velocity is not finite");
-    if (v3_len(nv) > w->def.max_linear_speed)
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "body_apply_impulse: resulting speed %g m/s is above the world's max_linear_speed %g m/s",
-                          v3_len(nv), w->def.max_linear_speed);
-    if (v3_len(nw) > world_spin_limit(&w->def))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "body_apply_impulse: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s",
-                          v3_len(nw), world_spin_limit(&w->def));
-    s->velocity[slot] = nv;
-    s->angular_velocity[slot] = nw;
-    world_wake_body(w, slot);
-    return CAROM_OK;
+    return motion_apply_impulse(w, slot, j, point);
 }
 
 CAROM_API carom_status carom_body_apply_force(carom_world *w, carom_body_id id, carom_vec3 force)
@@ -793,16 +742,5 @@ CAROM_API carom_status carom_body_apply_force(carom_world *w, carom_body_id id, 
     GET_SLOT(w, id, "body_apply_force");
     if (w->in_callback) return world_defer_op(w, DEFER_FORCE, id, force, NULL, "body_apply_force");
     REQUIRE_UNLOCKED(w, "body_apply_force");
-    if (!finite_c(force)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_apply_force: force must be finite");
-    body_store *s = &w->bodies;
-    if (s->type[slot] != CAROM_BODY_DYNAMIC) return CAROM_OK;
-    vec3 total = v3_add(s->force[slot], to_v3(force));
-    if (!(v3_len(total) * s->inv_mass[slot] <= RANGE_ACCELERATION_MAX))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "body_apply_force: the body's total force %g N over its mass %g kg is above 1e9 m/s^2",
-                          v3_len(total), s->mass[slot]);
-    s->force[slot] = total;
-    s->flags[slot] |= BODY_HAS_FORCE;
-    world_wake_body(w, slot);
-    return CAROM_OK;
+    return motion_apply_force(w, slot, force);
 }

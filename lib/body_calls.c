@@ -1,20 +1,11 @@
 /* body_calls.c - the body calls a game reaches for beyond the basics:
  * angular impulses, damping after creation, frame conversions, the shape
  * back as a def, and the previous pose for interpolation. */
-#include "body_calls.h"
 #include "body_args.h"
+#include "body_motion.h"
 #include "deferred.h"
 #include "ranges.h"
 #include "world.h"
-
-void world_remember_poses(carom_world *w)
-{
-    body_store *s = &w->bodies;
-    for (int i = 0; i < s->count; i++) {
-        s->previous_origin[i] = body_origin(s, i);
-        s->previous_rotation[i] = s->rotation[i];
-    }
-}
 
 CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *w, carom_body_id id, carom_vec3 impulse)
 {
@@ -22,18 +13,7 @@ CAROM_API carom_status carom_body_apply_angular_impulse(carom_world *w, carom_bo
     SLOT_OR_FAIL(fn);
     if (w->in_callback) return world_defer_op(w, DEFER_ANGULAR_IMPULSE, id, impulse, NULL, fn);
     UNLOCKED_OR_FAIL(fn);
-    if (!args_finite(impulse)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: impulse must be finite", fn);
-    body_store *s = &w->bodies;
-    if (s->type[slot] != CAROM_BODY_DYNAMIC || (s->flags[slot] & BODY_LOCK_ROTATION)) return CAROM_OK;
-    vec3 nw = v3_add(s->angular_velocity[slot], m3_mulv(s->inv_inertia_world[slot], args_v3(impulse)));
-    if (s->flags[slot] & BODY_LOCK_PLANE) nw = v3_scale(s->plane_normal[slot], v3_dot(nw, s->plane_normal[slot]));
-    if (!(v3_len(nw) <= world_spin_limit(&w->def)))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
-                          "%s: resulting spin %g rad/s is above the world's max_angular_speed %g rad/s", fn, v3_len(nw),
-                          world_spin_limit(&w->def));
-    s->angular_velocity[slot] = nw;
-    world_wake_body(w, slot);
-    return CAROM_OK;
+    return motion_apply_angular_impulse(w, slot, impulse);
 }
 
 CAROM_API carom_status carom_body_set_damping(carom_world *w, carom_body_id id, double linear, double angular)

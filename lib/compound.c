@@ -1,7 +1,10 @@
-/* compound.c - bodies made of several convex children: combined mass
- * properties, bounds, ray casts, and the contacts of every pair that has a
- * mesh, height field or compound on either side (one manifold per child
- * pair, a mesh's split further by normal). */
+/* compound.c - the contacts of any pair of shapes: collide() is every
+ * caller's entry; a pair with a mesh, height field or compound on either side
+ * goes through collide_multi (one manifold per child pair, a mesh's split
+ * further by normal), a convex pair to the narrowphase (collide_convex). It
+ * sits above narrowphase.c and triangle_contact.c, which never call it: the
+ * recursion into children stays in this file. (A compound's mass, bounds and
+ * ray casts are shape.c's.) */
 #include <stdlib.h>
 #include <string.h>
 #include "narrowphase.h"
@@ -9,71 +12,10 @@
 #include "triangle_contact.h"
 #include "compound.h"
 
-void compound_free(compound *c)
-{
-    if (!c) return;
-    for (int i = 0; i < c->count; i++) shape_free_data(&c->children[i]);
-    free(c->children); free(c->poses); free(c->friction); free(c->restitution); free(c->density);
-    free(c->rolling_resistance); free(c->combine);
-    free(c);
-}
-
 static xform xf_mul(xform a, xform b)
 {
     xform r = {xf_point(a, b.p), q_mul(a.q, b.q)};
     return r;
-}
-
-mass_props compound_mass(const compound *c)
-{
-    mass_props total = {0, {0, 0, 0}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
-    mass_props part[256];
-    mass_props *parts = c->count <= 256 ? part : malloc(sizeof *parts * (size_t)c->count);
-    if (!parts) return total;
-    vec3 moment = v3_zero();
-    for (int i = 0; i < c->count; i++) {
-        parts[i] = shape_mass_from_density(&c->children[i], c->density[i]);
-        /* the child's centre in the body frame */
-        parts[i].center = xf_point(c->poses[i], parts[i].center);
-        total.mass += parts[i].mass;
-        moment = v3_madd(moment, parts[i].mass, parts[i].center);
-    }
-    total.center = total.mass > 0 ? v3_scale(moment, 1.0 / total.mass) : v3_zero();
-    /* each child's inertia turned into body axes, moved to the common centre */
-    for (int i = 0; i < c->count; i++) {
-        mat3 r = m3_from_quat(c->poses[i].q);
-        mat3 ii = m3_rotate_tensor(r, parts[i].inertia);
-        ii = m3_add(ii, m3_parallel_axis(parts[i].mass, v3_sub(parts[i].center, total.center)));
-        total.inertia = m3_add(total.inertia, ii);
-    }
-    if (parts != part) free(parts);
-    return total;
-}
-
-aabb compound_aabb(const compound *c, xform t)
-{
-    aabb b = shape_aabb(&c->children[0], xf_mul(t, c->poses[0]));
-    for (int i = 1; i < c->count; i++) b = aabb_union(b, shape_aabb(&c->children[i], xf_mul(t, c->poses[i])));
-    return b;
-}
-
-int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child)
-{
-    int found = 0;
-    double best = max_t;
-    for (int i = 0; i < c->count; i++) {
-        xform p = c->poses[i];
-        double tt;
-        vec3 n;
-        if (!shape_ray_cast_local(&c->children[i], xf_inv_point(p, o), q_inv_rotate(p.q, d), best, &tt, &n)) continue;
-        if (found && tt >= best) continue;
-        found = 1;
-        best = tt;
-        *normal = q_rotate(p.q, n);
-        if (child) *child = i;
-    }
-    if (found) *t = best;
-    return found;
 }
 
 /* ---- contacts ----------------------------------------------------------------- */
@@ -107,7 +49,7 @@ static void collide_parts(const shape *a, xform xa, const shape *b, xform xb, do
     memset(&cache, 0, sizeof cache);
     cache.feature = -1;
     manifold m;
-    if (collide(a, xa, b, xb, spec, &cache, &m) > 0) put(o, &m, base);
+    if (collide_convex(a, xa, b, xb, spec, &cache, &m) > 0) put(o, &m, base);
 }
 
 static int child_near(const shape *child, xform x, aabb other, double spec)
@@ -150,3 +92,20 @@ void compound_sub_children(const shape *a, const shape *b, uint32_t sub, int *ch
     *child_b = b->type == SHAPE_COMPOUND ? (int)(pair % (uint32_t)nb) : -1;
 }
 
+int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache, manifold *m)
+{
+    if (!shape_is_composite(a) && !shape_is_composite(b)) return collide_convex(a, xa, b, xb, speculative, cache, m);
+    memset(m, 0, sizeof *m);
+    m->normal = v3(0, 0, 1);
+    /* a pose that overflowed has no contacts */
+    if (!xf_is_finite(xa) || !xf_is_finite(xb)) return 0;
+    manifold all[PAIR_MAX_MANIFOLDS];
+    uint32_t base[PAIR_MAX_MANIFOLDS];
+    int n = collide_multi(a, xa, b, xb, speculative, all, base, PAIR_MAX_MANIFOLDS);
+    double deepest = 1e300;
+    for (int k = 0; k < n; k++)
+        for (int i = 0; i < all[k].count; i++)
+            if (all[k].points[i].separation < deepest) { deepest = all[k].points[i].separation; *m = all[k]; }
+    (void)cache;
+    return m->count;
+}

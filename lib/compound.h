@@ -1,17 +1,19 @@
-/* compound.h - compound shapes (compound.c): children at their own poses
- * and densities; their mass, bounds and ray casts, and the contacts of any
- * pair with a mesh, height field or compound on either side. */
+/* compound.h - the contacts of any pair of shapes (compound.c): collide(),
+ * and collide_multi for a pair with a mesh, height field or compound on
+ * either side. (A compound's mass, bounds and ray casts: shape.h.) */
 #ifndef CAROM_COMPOUND_H
 #define CAROM_COMPOUND_H
 
 #include "shape.h"
 #include "narrowphase.h"
 
-void compound_free(compound *c);
-/* Mass properties combined exactly (parallel axis); each child at its own density. */
-mass_props compound_mass(const compound *c);
-aabb compound_aabb(const compound *c, xform t);
-int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child);
+/* Contacts between shape a at xa and shape b at xb, including speculative
+ * points whose separation is below `speculative` (>= 0). Any order of types
+ * works (the normal always points from a to b). Returns m->count. Results are
+ * always finite. A pair with a mesh, height field or compound gives its
+ * deepest manifold only (the contact stage asks collide_multi for all). */
+int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative,
+            collide_cache *cache, manifold *m);
 
 /* Any pair with a mesh, height field or compound on either side: its
  * manifolds (normal a to b) and for each the base of its contact numbers

@@ -1,7 +1,8 @@
 /* deferred.c - velocity changes from event callbacks, applied after them
- * (see deferred.h). Each op runs exactly once, through the same public
- * entry a call outside the step would use, so it is checked the same way. */
+ * (see deferred.h). Each op runs exactly once, through the same checked
+ * change (body_motion.c) the public entry makes outside the step. */
 #include "array.h"
+#include "body_motion.h"
 #include "deferred.h"
 
 carom_status world_defer_op(carom_world *w, deferred_kind kind, carom_body_id id, carom_vec3 value,
@@ -30,15 +31,16 @@ void world_run_deferred_ops(carom_world *w)
     /* ops never queue more ops: the world is unlocked and out of its callbacks */
     for (int i = 0; i < s->deferred_op_count; i++) {
         deferred_op op = s->deferred_ops[i];
-        if (!carom_body_is_valid(w, op.id)) continue;
+        int slot = body_store_slot(&w->bodies, op.id.index1, op.id.generation);
+        if (slot < 0) continue; /* destroyed since */
         switch (op.kind) {
-        case DEFER_IMPULSE: carom_body_apply_impulse(w, op.id, op.value, op.has_point ? &op.point : NULL); break;
-        case DEFER_ANGULAR_IMPULSE: carom_body_apply_angular_impulse(w, op.id, op.value); break;
-        case DEFER_LINEAR_VELOCITY: carom_body_set_linear_velocity(w, op.id, op.value); break;
-        case DEFER_ANGULAR_VELOCITY: carom_body_set_angular_velocity(w, op.id, op.value); break;
-        case DEFER_FORCE: carom_body_apply_force(w, op.id, op.value); break;
-        case DEFER_TORQUE: carom_body_apply_torque(w, op.id, op.value); break;
-        case DEFER_FORCE_AT_POINT: carom_body_apply_force_at_point(w, op.id, op.value, op.point); break;
+        case DEFER_IMPULSE: motion_apply_impulse(w, slot, op.value, op.has_point ? &op.point : NULL); break;
+        case DEFER_ANGULAR_IMPULSE: motion_apply_angular_impulse(w, slot, op.value); break;
+        case DEFER_LINEAR_VELOCITY: motion_set_linear_velocity(w, slot, op.value); break;
+        case DEFER_ANGULAR_VELOCITY: motion_set_angular_velocity(w, slot, op.value); break;
+        case DEFER_FORCE: motion_apply_force(w, slot, op.value); break;
+        case DEFER_TORQUE: motion_apply_torque(w, slot, op.value); break;
+        case DEFER_FORCE_AT_POINT: motion_apply_force_at_point(w, slot, op.value, op.point); break;
         }
     }
     s->deferred_op_count = 0;

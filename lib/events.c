@@ -84,3 +84,37 @@ int events_sensor(carom_world *w, carom_event_type type, carom_body_id sensor, c
     e.point = point;
     return push_event(w, &e, -1);
 }
+
+/* The lower positive threshold of the two, or 0 when neither asks. */
+static double pair_threshold(double a, double b)
+{
+    if (a > 0 && b > 0) return a < b ? a : b;
+    return a > 0 ? a : b;
+}
+
+void events_raise_forces(carom_world *w, const contact_constraint *constraints, int count, double dt)
+{
+    const body_store *s = &w->bodies;
+    /* Most worlds set no threshold: one sequential pass over the bodies is
+     * cheaper than visiting every constraint's two bodies at random. */
+    int any = 0;
+    for (int i = 0; i < s->count && !any; i++) any = s->force_threshold[i] > 0;
+    if (!any) return;
+    for (int k = 0; k < count; k++) {
+        const contact_constraint *con = &constraints[k];
+        const contact *c = &w->contacts.items[con->contact];
+        int sa = s->ids[c->id_a].slot, sb = s->ids[c->id_b].slot;
+        double threshold = pair_threshold(s->force_threshold[sa], s->force_threshold[sb]);
+        if (!(threshold > 0)) continue;
+        double total = 0.0;
+        vec3 weighted = v3_zero();
+        for (int j = 0; j < con->count; j++) {
+            double impulse = dmax(con->p[j].total_normal_impulse, 0.0);
+            total += impulse;
+            weighted = v3_madd(weighted, impulse, con->m->points[j].point);
+        }
+        double force = total / dt;
+        if (!(force > threshold)) continue;
+        events_force(w, con->contact, force * dt, force, v3_scale(weighted, 1.0 / total));
+    }
+}

@@ -26,6 +26,7 @@
  * what it would not have travelled: -dv tau dt. */
 #include <stdlib.h>
 #include <string.h>
+#include "compound.h"
 #include "world.h"
 #include "impact.h"
 

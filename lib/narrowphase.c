@@ -6,7 +6,6 @@
 #include <string.h>
 #include <ccd/ccd.h>
 #include "manifold.h"
-#include "compound.h"
 
 #define FACE_TOLERANCE 1e-3   /* prefer a face axis unless an edge axis separates more than this (m) */
 #define KEEP_TOLERANCE 5e-4   /* keep last step's reference face when within this (m) */
@@ -901,29 +900,14 @@ static void collide_ordered(const shape *a, xform xa, const shape *b, xform xb, 
     else poly_poly(a, xa, b, xb, spec, cache, m);
 }
 
-static int xform_is_finite(xform x)
-{
-    return v3_is_finite(x.p) && isfinite(x.q.x) && isfinite(x.q.y) && isfinite(x.q.z) && isfinite(x.q.w);
-}
-
-int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache, manifold *m)
+int collide_convex(const shape *a, xform xa, const shape *b, xform xb, double speculative, collide_cache *cache,
+                   manifold *m)
 {
     memset(m, 0, sizeof *m);
     m->normal = v3(0, 0, 1);
     /* a pose that overflowed has no contacts (the feature searches below would
      * find no best face and index with -1) */
-    if (!xform_is_finite(xa) || !xform_is_finite(xb)) return 0;
-    if (shape_is_composite(a) || shape_is_composite(b)) {
-        manifold all[PAIR_MAX_MANIFOLDS];
-        uint32_t base[PAIR_MAX_MANIFOLDS];
-        int n = collide_multi(a, xa, b, xb, speculative, all, base, PAIR_MAX_MANIFOLDS);
-        double deepest = 1e300;
-        for (int k = 0; k < n; k++)
-            for (int i = 0; i < all[k].count; i++)
-                if (all[k].points[i].separation < deepest) { deepest = all[k].points[i].separation; *m = all[k]; }
-        (void)cache;
-        return m->count;
-    }
+    if (!xf_is_finite(xa) || !xf_is_finite(xb)) return 0;
     int swap = a->type > b->type;
     /* capsule (2) against box (1) is handled box-first; everything else by type order */
     if (swap) {

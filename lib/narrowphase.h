@@ -29,13 +29,13 @@ typedef struct collide_cache {
     int flip;            /* last reference face belonged to B */
 } collide_cache;
 
-/* Contacts between shape a at xa and shape b at xb, including speculative
- * points whose separation is below `speculative` (>= 0). Any order of types
- * works (the normal always points from a to b). Returns m->count. Results are
- * always finite. A mesh or height field gives its deepest manifold only (the
- * contact stage asks collide_composite for all of them). */
-int collide(const shape *a, xform xa, const shape *b, xform xb, double speculative,
-            collide_cache *cache, manifold *m);
+/* Contacts between two convex shapes (sphere, box, capsule, cylinder, hull;
+ * plane against those), a at xa and b at xb, including speculative points
+ * whose separation is below `speculative` (>= 0). Any order of types works
+ * (the normal always points from a to b). Returns m->count. Results are
+ * always finite. Any pair at all: collide (compound.c). */
+int collide_convex(const shape *a, xform xa, const shape *b, xform xb, double speculative,
+                   collide_cache *cache, manifold *m);
 
 /* Most manifolds a convex shape gets against one mesh or height field. */
 #define COMPOSITE_MAX_MANIFOLDS 4

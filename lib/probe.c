@@ -1,6 +1,7 @@
 /* probe.c - accuracy probes (energy, momentum, penetration) and the AABB
  * query over the world (ray and shape queries: query.c). */
 #include <string.h>
+#include "compound.h"
 #include "world.h"
 
 CAROM_API carom_status carom_world_get_energy(const carom_world *w, double *kinetic, double *potential)

@@ -8,7 +8,6 @@
 #include "shape.h"
 #include "mesh.h"
 #include "heightfield.h"
-#include "compound.h"
 
 #define PI 3.14159265358979323846
 #define PLANE_EXTENT 1e18
@@ -386,4 +385,73 @@ int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t
     *t = tt;
     *normal = n;
     return 1;
+}
+
+/* ---- compounds: their children through the functions above ------------------- */
+
+void compound_free(compound *c)
+{
+    if (!c) return;
+    for (int i = 0; i < c->count; i++) shape_free_data(&c->children[i]);
+    free(c->children); free(c->poses); free(c->friction); free(c->restitution); free(c->density);
+    free(c->rolling_resistance); free(c->combine);
+    free(c);
+}
+
+static xform xf_mul(xform a, xform b)
+{
+    xform r = {xf_point(a, b.p), q_mul(a.q, b.q)};
+    return r;
+}
+
+mass_props compound_mass(const compound *c)
+{
+    mass_props total = {0, {0, 0, 0}, {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}};
+    mass_props part[256];
+    mass_props *parts = c->count <= 256 ? part : malloc(sizeof *parts * (size_t)c->count);
+    if (!parts) return total;
+    vec3 moment = v3_zero();
+    for (int i = 0; i < c->count; i++) {
+        parts[i] = shape_mass_from_density(&c->children[i], c->density[i]);
+        /* the child's centre in the body frame */
+        parts[i].center = xf_point(c->poses[i], parts[i].center);
+        total.mass += parts[i].mass;
+        moment = v3_madd(moment, parts[i].mass, parts[i].center);
+    }
+    total.center = total.mass > 0 ? v3_scale(moment, 1.0 / total.mass) : v3_zero();
+    /* each child's inertia turned into body axes, moved to the common centre */
+    for (int i = 0; i < c->count; i++) {
+        mat3 r = m3_from_quat(c->poses[i].q);
+        mat3 ii = m3_rotate_tensor(r, parts[i].inertia);
+        ii = m3_add(ii, m3_parallel_axis(parts[i].mass, v3_sub(parts[i].center, total.center)));
+        total.inertia = m3_add(total.inertia, ii);
+    }
+    if (parts != part) free(parts);
+    return total;
+}
+
+aabb compound_aabb(const compound *c, xform t)
+{
+    aabb b = shape_aabb(&c->children[0], xf_mul(t, c->poses[0]));
+    for (int i = 1; i < c->count; i++) b = aabb_union(b, shape_aabb(&c->children[i], xf_mul(t, c->poses[i])));
+    return b;
+}
+
+int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child)
+{
+    int found = 0;
+    double best = max_t;
+    for (int i = 0; i < c->count; i++) {
+        xform p = c->poses[i];
+        double tt;
+        vec3 n;
+        if (!shape_ray_cast_local(&c->children[i], xf_inv_point(p, o), q_inv_rotate(p.q, d), best, &tt, &n)) continue;
+        if (found && tt >= best) continue;
+        found = 1;
+        best = tt;
+        *normal = q_rotate(p.q, n);
+        if (child) *child = i;
+    }
+    if (found) *t = best;
+    return found;
 }

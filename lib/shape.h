@@ -15,7 +15,7 @@ enum {
     SHAPE_PLANE,        /* static only: points x with dot(normal, x) = offset (body frame); solid below */
     SHAPE_MESH,         /* static or kinematic: triangles (mesh.h) */
     SHAPE_HEIGHTFIELD,  /* static or kinematic: a grid of heights (mesh.h) */
-    SHAPE_COMPOUND,     /* convex children, each with a pose and material (compound.c) */
+    SHAPE_COMPOUND,     /* convex children, each with a pose and material (shape.c; contacts: compound.c) */
     SHAPE_TYPE_COUNT
 };
 
@@ -72,5 +72,12 @@ double shape_bounding_radius(const shape *s);
  * t in [0, max_t]. Returns 1 and sets *t and *normal (outward) on a hit;
  * a ray starting inside the shape does not hit. */
 int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t, vec3 *normal);
+
+/* A compound's own (shape.c: they recurse through the shape functions above). */
+void compound_free(compound *c);
+/* Mass properties combined exactly (parallel axis); each child at its own density. */
+mass_props compound_mass(const compound *c);
+aabb compound_aabb(const compound *c, xform t);
+int compound_ray_cast_local(const compound *c, vec3 o, vec3 d, double max_t, double *t, vec3 *normal, int *child);
 
 #endif

@@ -20,7 +20,7 @@
  *   finish_impacts         bounced bodies keep the rest of the step (impact.c)
  *   store_impulses         for next step's warm start
  *   raise_hit_events       impacts above the threshold
- *   forces_raise_events    pairs pressed above a body's force threshold (forces.c)
+ *   events_raise_forces    pairs pressed above a body's force threshold (events.c)
  *   finish_bodies          velocities written back, clamps, NaN guard, inertia
  *
  * A new pass over the constraints plugs in as a stage here, with a scalar
@@ -36,7 +36,6 @@
 #include "rotation.h"
 #include "impact.h"
 #include "events.h"
-#include "forces.h"
 #include "tasks.h"
 
 /* Below this many manifolds the wide passes gain nothing (mostly empty
@@ -700,7 +699,7 @@ int world_solve(carom_world *w, step_context *ctx)
     finish_impacts(w, ctx, &work);
     store_impulses(w, ctx);
     raise_hit_events(w, ctx);
-    forces_raise_events(w, ctx->constraints, ctx->constraint_count, ctx->dt);
+    events_raise_forces(w, ctx->constraints, ctx->constraint_count, ctx->dt);
     finish_bodies(w, ctx, &work);
     return 1;
 }

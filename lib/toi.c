@@ -24,6 +24,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "filter.h"
+#include "compound.h"
 #include "world.h"
 #include "toi.h"
 

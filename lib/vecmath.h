@@ -151,6 +151,10 @@ static inline mat3 m3_parallel_axis(double m, vec3 d)
 
 static inline vec3 xf_point(xform t, vec3 p) { return v3_add(t.p, q_rotate(t.q, p)); }
 static inline vec3 xf_inv_point(xform t, vec3 p) { return q_inv_rotate(t.q, v3_sub(p, t.p)); }
+static inline int xf_is_finite(xform t)
+{
+    return v3_is_finite(t.p) && isfinite(t.q.x) && isfinite(t.q.y) && isfinite(t.q.z) && isfinite(t.q.w);
+}
 
 typedef struct aabb { vec3 lo, hi; } aabb;
 static inline int aabb_overlap(aabb a, aabb b)

@@ -6,7 +6,6 @@
 #include <string.h>
 #include <time.h>
 #include "array.h"
-#include "body_calls.h"
 #include "deferred.h"
 #include "sensor.h"
 #include "world.h"

@@ -61,3 +61,12 @@ void world_destroy_body(carom_world *w, int id_index)
     shape_free_data(&w->bodies.shapes[slot]);
     body_store_remove(&w->bodies, slot);
 }
+
+void world_remember_poses(carom_world *w)
+{
+    body_store *s = &w->bodies;
+    for (int i = 0; i < s->count; i++) {
+        s->previous_origin[i] = body_origin(s, i);
+        s->previous_rotation[i] = s->rotation[i];
+    }
+}

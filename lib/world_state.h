@@ -19,5 +19,7 @@ void world_wake_body(carom_world *w, int slot);
 void world_remove_body_contacts(carom_world *w, int id_index);
 /* Removes the live body at id_index: its contacts, proxy, shape data, slot. */
 void world_destroy_body(carom_world *w, int id_index);
+/* Records every body's pose as its previous pose, at the start of the step. */
+void world_remember_poses(carom_world *w);
 
 #endif

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 #include "carom/carom.h"
 #include "world.h"
+#include "compound.h"
 
 #include "helpers.h"
 

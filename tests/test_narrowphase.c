@@ -11,6 +11,7 @@
 #include <string.h>
 #include <math.h>
 #include "narrowphase.h"
+#include "compound.h"
 #include "shape.h"
 #include "mesh.h"
 #include "helpers.h"

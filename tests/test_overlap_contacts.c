@@ -16,6 +16,7 @@
 #include <cmocka.h>
 #include "world.h"
 #include "narrowphase.h"
+#include "compound.h"
 #include "gjk.h"
 
 static uint64_t rng = 88172645463325252ull;

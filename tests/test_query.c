@@ -15,6 +15,7 @@
 #include "carom/carom.h"
 #include "helpers.h"
 #include "world.h"
+#include "compound.h"
 #include "narrowphase.h"
 
 enum { N_CONVEX = 5 };
