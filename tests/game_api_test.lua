@@ -3,26 +3,8 @@
 -- query with a mask and with a filter function, and their errors. Values are
 -- the geometry worked by hand. Run by `make check` with carom-run --test.
 local carom = require "carom"
-local passed, failed = 0, 0
-
-local function test(name, fn)
-  local ok, err = xpcall(fn, debug.traceback)
-  if ok then passed = passed + 1 else failed = failed + 1; print("FAIL " .. name .. ": " .. tostring(err)) end
-end
-
-local function near(got, want, tol, what)
-  if type(got) ~= "number" or not (math.abs(got - want) <= tol) then
-    error(string.format("%s: got %s, expected %.12g (tolerance %g)", what or "value", tostring(got), want, tol), 2)
-  end
-end
-
-local function raises(text, fn, ...)
-  local ok, err = pcall(fn, ...)
-  if ok then error("expected an error containing '" .. text .. "', but the call succeeded", 2) end
-  if not tostring(err):find(text, 1, true) then
-    error("the error '" .. tostring(err) .. "' does not contain '" .. text .. "'", 2)
-  end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local test, near, raises = T.test, T.near, T.raises
 
 local function ground_and_ball(ground_keys, ball_keys)
   local w = carom.world{}
@@ -302,5 +284,4 @@ test("set_pair_filter: contacts and continuous collision, errors raised by step"
   w2:step(1/60)
 end)
 
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+T.finish()

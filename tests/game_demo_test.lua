@@ -12,10 +12,8 @@ local f = assert(io.open(out))
 local text = f:read("a")
 f:close()
 os.remove(out)
-local passed, failed = 0, 0
-local function check(cond, what)
-  if cond then passed = passed + 1 else failed = failed + 1; print("FAIL " .. what) end
-end
+local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
+local check = T.check
 check(ok, "carom-run demos/game.lua exits 0:\n" .. text)
 local rest, launched = text:match("one%-way platform: (%d+) of (%d+) balls launched from below went up through it and rest on it")
 check(rest and rest == launched and tonumber(launched) >= 3, "every launched ball rests on the platform")
@@ -29,6 +27,5 @@ local paddle = tonumber(text:match("paddle: hit (%d+) balls"))
 check(paddle and paddle >= 1, "the paddle hits balls")
 local shots, hits = text:match("ray gun: (%d+) shots, (%d+) hits")
 check(tonumber(shots) and tonumber(hits) >= 1, "the gun hits")
-if failed > 0 then print(text) end
-print(string.format("%d passed, %d failed", passed, failed))
-if failed > 0 then os.exit(1) end
+if T.failed > 0 then print(text) end
+T.finish()
