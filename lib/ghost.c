@@ -22,6 +22,7 @@
  * sixteen points whose iterative solution twists it. */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "world.h"
 #include "ghost.h"
 #include "manifold.h"
@@ -107,6 +108,20 @@ static double surface_offset(const manifold *m, vec3 n)
     return v3_dot(n, m->points[0].point) - 0.5 * m->points[0].separation;
 }
 
+/* A merged manifold kept by one of its contacts: the points another
+ * contact gave keep no feature id (the same id names another place on the
+ * other body: identical mesh patches number their triangles alike, so a
+ * patch's point matched another patch's impulse next step and a box on
+ * 2 m patches of 3 x 3 cells was thrown 1 m off its path); they are
+ * matched by position only. */
+#define FOREIGN_ID 0xfffffff0u
+
+static void own_ids(manifold *m, const int *owner, int contact)
+{
+    for (int k = 0; k < m->count; k++)
+        if (owner[k] != contact) m->points[k].id = FOREIGN_ID | (uint32_t)k;
+}
+
 /* Merges, per dynamic body, the manifolds against static bodies on one plane
  * into the first of them (entries sorted by dynamic body, ghosts unlisted).
  * Returns how many manifolds were taken off the touching list. */
@@ -126,9 +141,9 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
             double hi = surface_offset(&di->m, e[i].normal);
             manifold_point pts[MERGE_MAX];
             contact_point_state st[MERGE_MAX];
-            int group[MERGE_MAX];
+            int group[MERGE_MAX], from[MERGE_MAX]; /* from: the contact a candidate comes from */
             int np = 0, merged = 0;
-            for (int k = 0; k < di->m.count; k++) { pts[np] = di->m.points[k]; st[np] = di->state[k]; np++; }
+            for (int k = 0; k < di->m.count; k++) { pts[np] = di->m.points[k]; st[np] = di->state[k]; from[np] = e[i].contact; np++; }
             for (int j = i + 1; j < last; j++) {
                 if (e[j].listed < 0 || e[j].other == e[i].other) continue;
                 if (s->type[s->ids[e[j].other].slot] != CAROM_BODY_STATIC) continue;
@@ -143,6 +158,7 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
                     pts[np] = dj->m.points[k];
                     st[np] = dj->state[k];
                     if (!same_basis) st[np].tangent_impulse[0] = st[np].tangent_impulse[1] = 0;
+                    from[np] = e[j].contact;
                     np++;
                 }
                 sc->touching[e[j].listed] = -1;
@@ -158,9 +174,11 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
             for (int k = 0; k < np; k++) { all[k] = pts[k]; ids[k] = pts[k].id; pts[k].id = (uint32_t)k; }
             vec3 mn = di->m.normal;
             int c = manifold_outline(pts, np, mn);
-            c = manifold_reduce(pts, c, mn);
+            c = manifold_reduce_outline(pts, c, mn);
             contact_point_state kept[MANIFOLD_MAX_POINTS];
+            int owner[MANIFOLD_MAX_POINTS];
             for (int k = 0; k < c; k++) {
+                owner[k] = from[pts[k].id];
                 /* where bodies meet, several give the same point: keep the state
                  * that carries the most (the others may be fresh) */
                 int src = (int)pts[k].id;
@@ -173,15 +191,28 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
             }
             for (int k = 0; k < c; k++) { di->m.points[k] = pts[k]; di->state[k] = kept[k]; }
             di->m.count = c;
+            own_ids(&di->m, owner, e[i].contact);
             /* this step's manifold is no longer the narrowphase's own: recompute it next step */
             cs->items[e[i].contact].flags &= ~(uint32_t)CONTACT_REUSABLE;
-            /* the others remember it too: whichever leads next step warm-starts from it */
+            /* the others remember it too: whichever leads next step warm-starts
+             * from it (world_share_merged_impulses gives them the solved
+             * impulses; a point only another body's manifold has next step
+             * would else start from this step's guess, never from a solved
+             * impulse: the front corners of a box sliding onto the next tile
+             * started from zero every step, and at one iteration (fast) the
+             * box rocked at 1.3 mm/s vertical) */
             for (int g = 0; g < merged; g++) {
                 contact_data *dj = &cs->data[e[group[g]].contact];
                 vec3 nj = dj->m.normal;
                 dj->m = di->m;
                 dj->m.normal = v3_dot(nj, mn) < 0 ? v3_neg(mn) : mn;
-                for (int k = 0; k < c; k++) dj->state[k] = kept[k];
+                for (int k = 0; k < c; k++) { dj->m.points[k].id = pts[k].id; dj->state[k] = kept[k]; }
+                own_ids(&dj->m, owner, e[group[g]].contact);
+                if (array_reserve((void **)&sc->merged, &sc->merged_capacity, 2 * sc->merged_count + 2, sizeof *sc->merged)) {
+                    sc->merged[2 * sc->merged_count] = e[i].contact;
+                    sc->merged[2 * sc->merged_count + 1] = e[group[g]].contact;
+                    sc->merged_count++;
+                }
             }
         }
         first = last;
@@ -189,11 +220,46 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
     return removed;
 }
 
+void world_share_merged_impulses(carom_world *w)
+{
+    const body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    step_scratch *sc = &w->scratch;
+    for (int k = 0; k < sc->merged_count; k++) {
+        int lead = sc->merged[2 * k], follower = sc->merged[2 * k + 1];
+        const contact_data *dl = &cs->data[lead];
+        contact_data *df = &cs->data[follower];
+        const contact *cf = &cs->items[follower];
+        if (df->m.count != dl->m.count) continue;
+        /* the same order of bodies (the normal's sign): the friction basis
+         * and its impulses carry over as they are, else only the normal's */
+        int same = v3_dot(df->m.normal, dl->m.normal) > 0;
+        int a = s->ids[cf->id_a].slot;
+        xform xa = s->type[a] == CAROM_BODY_STATIC ? body_xform(s, a) : sc->pose[a];
+        for (int i = 0; i < dl->m.count; i++) {
+            /* only the follower's own points (own_ids): another body's
+             * impulse kept here would warm-start this contact too, twice
+             * the load where the two are solved apart next step */
+            contact_point_state st = dl->state[i];
+            if (df->m.points[i].id >= FOREIGN_ID) {
+                st.normal_impulse = 0;
+                st.tangent_impulse[0] = st.tangent_impulse[1] = 0;
+            }
+            if (!same) st.tangent_impulse[0] = st.tangent_impulse[1] = 0;
+            st.local_a = xf_inv_point(xa, dl->m.points[i].point);
+            df->state[i] = st;
+        }
+        if (same) df->tangent1 = dl->tangent1;
+    }
+    sc->merged_count = 0;
+}
+
 void world_remove_ghost_contacts(carom_world *w)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
+    sc->merged_count = 0;
     int n = 0;
     for (int k = 0; k < sc->touching_count; k++) {
         const contact *c = &cs->items[sc->touching[k]];

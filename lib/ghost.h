@@ -6,5 +6,8 @@
 #include "step.h"
 
 void world_remove_ghost_contacts(carom_world *w);
+/* After the solve: every manifold merged into another this step takes the
+ * merged manifold's solved impulses (warm starting of the next step). */
+void world_share_merged_impulses(carom_world *w);
 
 #endif

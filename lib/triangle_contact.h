@@ -19,5 +19,8 @@ int collide_triangle(const vec3 v[3], unsigned active, int two_sided, const shap
  * 64 points; collinear and inner points dropped, order along the outline);
  * returns the new count. */
 int manifold_outline(manifold_point *pts, int n, vec3 normal);
+/* manifold_reduce for an outline's corners: the fourth point is the one
+ * that adds the most area outside the first three's triangle. */
+int manifold_reduce_outline(manifold_point *pts, int n, vec3 normal);
 
 #endif

@@ -202,7 +202,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
     free(s->tight_box); free(s->pose); free(s->touching);
     free(w->sensor_overlaps);
-    free(s->new_pairs); free(s->asleep_pairs); free(s->toi);
+    free(s->new_pairs); free(s->asleep_pairs); free(s->toi); free(s->merged);
     free(w);
 }
 
@@ -317,6 +317,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
             w->locked = 0;
             return CAROM_ERROR_INVALID_ARGUMENT;
         }
+        if (ok) world_share_merged_impulses(w);
     }
     double t4 = now_ms();
     if (ok && w->def.enable_continuous) ok = world_continuous(w, &ctx);

@@ -51,6 +51,8 @@ typedef struct step_scratch {
     int new_pair_count, new_pair_capacity;
     struct deferred_op *deferred_ops; /* velocity changes from callbacks (deferred.c) */
     int deferred_op_count, deferred_op_capacity;
+    int *merged;                /* ghost.c: (lead, follower) contact indices of this step's coplanar merges */
+    int merged_count, merged_capacity; /* pairs, capacity in ints */
 } step_scratch;
 
 /* A sensor and a body overlapping it after the last step (sensor.c). */
