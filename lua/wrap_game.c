@@ -457,18 +457,33 @@ static int body_contacts(lua_State *L)
     return 1;
 }
 
-static const char pre_solve_key = 'p'; /* registry: weak-keyed {world userdata = fn} */
+static const char pre_solve_key = 'p';   /* registry: weak-keyed {world userdata = fn} */
+static const char pair_filter_key = 'f'; /* the same for the pair filter */
 
-/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids), 4 = manifold. */
-static int dispatch_pre_solve(lua_State *L)
+/* Inside a dispatcher: pushes the world's function under key and bodies a, b
+ * (light ids at 2 and 3). */
+static void push_hook(lua_State *L, const char *key)
 {
     const carom_body_id *a = lua_touserdata(L, 2), *b = lua_touserdata(L, 3);
-    const carom_manifold *m = lua_touserdata(L, 4);
-    lua_rawgetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, key);
     lua_pushvalue(L, 1);
     lua_rawget(L, -2);
     clua_push_body(L, 1, *a);
     clua_push_body(L, 1, *b);
+}
+
+/* The hook's answer: only false refuses. */
+static int hook_answer(lua_State *L)
+{
+    lua_pushboolean(L, !(lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1)));
+    return 1;
+}
+
+/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids), 4 = manifold. */
+static int dispatch_pre_solve(lua_State *L)
+{
+    const carom_manifold *m = lua_touserdata(L, 4);
+    push_hook(L, &pre_solve_key);
     lua_createtable(L, 0, 3);
     clua_push_vec3_table(L, m->normal);
     lua_setfield(L, -2, "normal");
@@ -483,26 +498,35 @@ static int dispatch_pre_solve(lua_State *L)
     lua_setfield(L, -3, "separations");
     lua_setfield(L, -2, "points");
     lua_call(L, 3, 1);
-    lua_pushboolean(L, !(lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))); /* only false refuses */
-    return 1;
+    return hook_answer(L);
 }
 
-static int lua_pre_solve(void *context, carom_body_id a, carom_body_id b, const carom_manifold *m)
+/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids). */
+static int dispatch_pair_filter(lua_State *L)
 {
-    clua_world *lw = context;
+    push_hook(L, &pair_filter_key);
+    lua_call(L, 2, 1);
+    return hook_answer(L);
+}
+
+/* Calls dispatch(world, a, b[, m]) protected on the stepping state; an error
+ * is kept for the step to raise afterwards, like a contact callback's, and
+ * the pair kept. Returns 1 to keep the pair. */
+static int run_hook(clua_world *lw, lua_CFunction dispatch, carom_body_id a, carom_body_id b, const carom_manifold *m)
+{
     lua_State *L = lw->stepping;
     if (!L || lw->callback_failed) return 1;
     int top = lua_gettop(L);
     if (!lua_checkstack(L, 12)) return 1;
     lua_pushcfunction(L, clua_traceback);
-    lua_pushcfunction(L, dispatch_pre_solve);
+    lua_pushcfunction(L, dispatch);
     lua_pushvalue(L, 1);
     lua_pushlightuserdata(L, &a);
     lua_pushlightuserdata(L, &b);
-    lua_pushlightuserdata(L, (void *)m);
+    if (m) lua_pushlightuserdata(L, (void *)m);
     int keep = 1;
-    if (lua_pcall(L, 4, 1, top + 1) != LUA_OK) {
-        lw->callback_failed = 1; /* step raises it afterwards, like a contact callback's */
+    if (lua_pcall(L, m ? 4 : 3, 1, top + 1) != LUA_OK) {
+        lw->callback_failed = 1;
         lua_setiuservalue(L, 1, WORLD_UV_ERROR);
     } else {
         keep = lua_toboolean(L, -1);
@@ -511,43 +535,29 @@ static int lua_pre_solve(void *context, carom_body_id a, carom_body_id b, const 
     return keep;
 }
 
-static const char pair_filter_key = 'f'; /* registry: weak-keyed {world userdata = fn} */
-
-/* Runs protected inside the step: 1 = world, 2 = a, 3 = b (light ids). */
-static int dispatch_pair_filter(lua_State *L)
+static int lua_pre_solve(void *context, carom_body_id a, carom_body_id b, const carom_manifold *m)
 {
-    const carom_body_id *a = lua_touserdata(L, 2), *b = lua_touserdata(L, 3);
-    lua_rawgetp(L, LUA_REGISTRYINDEX, &pair_filter_key);
-    lua_pushvalue(L, 1);
-    lua_rawget(L, -2);
-    clua_push_body(L, 1, *a);
-    clua_push_body(L, 1, *b);
-    lua_call(L, 2, 1);
-    lua_pushboolean(L, !(lua_type(L, -1) == LUA_TBOOLEAN && !lua_toboolean(L, -1))); /* only false refuses */
-    return 1;
+    return run_hook(context, dispatch_pre_solve, a, b, m);
 }
 
 static int lua_pair_filter(void *context, carom_body_id a, carom_body_id b)
 {
-    clua_world *lw = context;
-    lua_State *L = lw->stepping;
-    if (!L || lw->callback_failed) return 1;
-    int top = lua_gettop(L);
-    if (!lua_checkstack(L, 8)) return 1;
-    lua_pushcfunction(L, clua_traceback);
-    lua_pushcfunction(L, dispatch_pair_filter);
+    return run_hook(context, dispatch_pair_filter, a, b, NULL);
+}
+
+/* world:set_...(fn or nil): checks it and keeps fn under key for the world;
+ * returns the world for the C setter. */
+static clua_world *set_hook(lua_State *L, const char *key, const char *name)
+{
+    clua_world *lw = clua_check_world(L, 1, name);
+    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TFUNCTION) clua_type_error(L, 2, name, "function or nil");
+    if (lw->stepping) luaL_error(L, "%s: cannot change it inside a contact callback", name);
+    lua_settop(L, 2);
+    lua_rawgetp(L, LUA_REGISTRYINDEX, key);
     lua_pushvalue(L, 1);
-    lua_pushlightuserdata(L, &a);
-    lua_pushlightuserdata(L, &b);
-    int keep = 1;
-    if (lua_pcall(L, 3, 1, top + 1) != LUA_OK) {
-        lw->callback_failed = 1; /* step raises it afterwards, like a contact callback's */
-        lua_setiuservalue(L, 1, WORLD_UV_ERROR);
-    } else {
-        keep = lua_toboolean(L, -1);
-    }
-    lua_settop(L, top);
-    return keep;
+    lua_pushvalue(L, 2);
+    lua_rawset(L, -3);
+    return clua_check_world(L, 1, name);
 }
 
 /* world:set_pair_filter(fn or nil): fn(a, b) for each new pair the bits
@@ -555,15 +565,7 @@ static int lua_pair_filter(void *context, carom_body_id a, carom_body_id b)
  * from touching. */
 static int world_set_pair_filter(lua_State *L)
 {
-    clua_world *lw = clua_check_world(L, 1, "set_pair_filter");
-    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TFUNCTION) clua_type_error(L, 2, "set_pair_filter", "function or nil");
-    if (lw->stepping) return luaL_error(L, "set_pair_filter: cannot change it inside a contact callback");
-    lua_settop(L, 2);
-    lua_rawgetp(L, LUA_REGISTRYINDEX, &pair_filter_key);
-    lua_pushvalue(L, 1);
-    lua_pushvalue(L, 2);
-    lua_rawset(L, -3);
-    lw = clua_check_world(L, 1, "set_pair_filter");
+    clua_world *lw = set_hook(L, &pair_filter_key, "set_pair_filter");
     carom_world_set_pair_filter(lw->world, lua_isfunction(L, 2) ? lua_pair_filter : NULL, lw);
     return 0;
 }
@@ -572,15 +574,7 @@ static int world_set_pair_filter(lua_State *L)
  * pair is solved; returning false leaves it out of this step. */
 static int world_set_pre_solve(lua_State *L)
 {
-    clua_world *lw = clua_check_world(L, 1, "set_pre_solve");
-    if (!lua_isnil(L, 2) && lua_type(L, 2) != LUA_TFUNCTION) clua_type_error(L, 2, "set_pre_solve", "function or nil");
-    if (lw->stepping) return luaL_error(L, "set_pre_solve: cannot change it inside a contact callback");
-    lua_settop(L, 2);
-    lua_rawgetp(L, LUA_REGISTRYINDEX, &pre_solve_key);
-    lua_pushvalue(L, 1);
-    lua_pushvalue(L, 2);
-    lua_rawset(L, -3);
-    lw = clua_check_world(L, 1, "set_pre_solve");
+    clua_world *lw = set_hook(L, &pre_solve_key, "set_pre_solve");
     carom_world_set_pre_solve(lw->world, lua_isfunction(L, 2) ? lua_pre_solve : NULL, lw);
     return 0;
 }
