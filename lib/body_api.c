@@ -224,19 +224,8 @@ static int build_hull(carom_world *w, const carom_shape_def *sd, shape *sh, cons
 static int build_compound(carom_world *w, const carom_body_def *d, shape *sh)
 {
     int n = d->child_count;
-    compound *c = calloc(1, sizeof *c);
-    if (c) {
-        c->children = calloc((size_t)n, sizeof *c->children);
-        c->poses = malloc(sizeof *c->poses * (size_t)n);
-        c->friction = malloc(sizeof *c->friction * (size_t)n);
-        c->restitution = malloc(sizeof *c->restitution * (size_t)n);
-        c->density = malloc(sizeof *c->density * (size_t)n);
-        c->rolling_resistance = malloc(sizeof *c->rolling_resistance * (size_t)n);
-        c->combine = malloc(sizeof *c->combine * (size_t)n);
-    }
-    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density || !c->rolling_resistance ||
-        !c->combine) {
-        compound_free(c);
+    compound *c = compound_alloc(n);
+    if (!c) {
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
         return 0;
     }

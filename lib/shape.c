@@ -389,6 +389,26 @@ int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t
 
 /* ---- compounds: their children through the functions above ------------------- */
 
+compound *compound_alloc(int n)
+{
+    compound *c = calloc(1, sizeof *c);
+    if (c) {
+        c->children = calloc((size_t)n, sizeof *c->children);
+        c->poses = malloc(sizeof *c->poses * (size_t)n);
+        c->friction = malloc(sizeof *c->friction * (size_t)n);
+        c->restitution = malloc(sizeof *c->restitution * (size_t)n);
+        c->density = malloc(sizeof *c->density * (size_t)n);
+        c->rolling_resistance = malloc(sizeof *c->rolling_resistance * (size_t)n);
+        c->combine = malloc(sizeof *c->combine * (size_t)n);
+    }
+    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density || !c->rolling_resistance ||
+        !c->combine) {
+        compound_free(c);
+        return NULL;
+    }
+    return c;
+}
+
 void compound_free(compound *c)
 {
     if (!c) return;

@@ -74,6 +74,8 @@ double shape_bounding_radius(const shape *s);
 int shape_ray_cast_local(const shape *s, vec3 o, vec3 d, double max_t, double *t, vec3 *normal);
 
 /* A compound's own (shape.c: they recurse through the shape functions above). */
+/* A compound with room for n children (count 0, children zeroed); NULL when out of memory. */
+compound *compound_alloc(int n);
 void compound_free(compound *c);
 /* Mass properties combined exactly (parallel axis); each child at its own density. */
 mass_props compound_mass(const compound *c);

@@ -681,21 +681,8 @@ static compound *read_compound(reader *r)
     if (r->failed) return NULL;
     if (n < 1 || n > 256) return bad(r, "compound of %d children", n), NULL;
     if (!need(r, (size_t)n * 99, "compound")) return NULL;
-    compound *c = calloc(1, sizeof *c);
-    if (c) {
-        c->children = calloc((size_t)n, sizeof *c->children);
-        c->poses = malloc(sizeof *c->poses * (size_t)n);
-        c->friction = malloc(sizeof *c->friction * (size_t)n);
-        c->restitution = malloc(sizeof *c->restitution * (size_t)n);
-        c->density = malloc(sizeof *c->density * (size_t)n);
-        c->rolling_resistance = malloc(sizeof *c->rolling_resistance * (size_t)n);
-        c->combine = malloc(sizeof *c->combine * (size_t)n);
-    }
-    if (!c || !c->children || !c->poses || !c->friction || !c->restitution || !c->density || !c->rolling_resistance ||
-        !c->combine) {
-        compound_free(c);
-        return bad(r, "out of memory"), NULL;
-    }
+    compound *c = compound_alloc(n);
+    if (!c) return bad(r, "out of memory"), NULL;
     for (int i = 0; i < n; i++) {
         c->poses[i].p = get_v3(r, "compound child pose");
         c->poses[i].q = get_q(r, "compound child pose");
