@@ -334,13 +334,21 @@ static int body_set_damping(lua_State *L)
     carom_body_id id;
     carom_world *w = clua_check_body_id(L, 1, "set_damping", &id);
     double lin = clua_check_number(L, 2, "set_damping"), ang = clua_check_number(L, 3, "set_damping");
-    carom_status st = carom_body_set_damping(w, id, lin, ang);
-    if (st == CAROM_ERROR_INVALID_ARGUMENT) {
+    /* which argument C refused, by status: the linear one alone first (with
+     * the angular kept), then both; a refused second call puts the first back */
+    double old_lin = 0.0, old_ang = 0.0;
+    carom_status st = carom_body_get_damping(w, id, &old_lin, &old_ang);
+    if (st == CAROM_OK) st = carom_body_set_damping(w, id, lin, old_ang);
+    if (st != CAROM_OK) return game_status(L, w, st, 2, "set_damping");
+    st = carom_body_set_damping(w, id, lin, ang);
+    if (st != CAROM_OK) {
         char buf[256];
         const char *msg = clua_copy_error(w, buf, sizeof buf);
-        return clua_arg_error(L, strstr(msg, "angular") ? 3 : 2, "set_damping", "%s", msg);
+        carom_body_set_damping(w, id, old_lin, old_ang);
+        if (st == CAROM_ERROR_INVALID_ARGUMENT) return clua_arg_error(L, 3, "set_damping", "%s", msg);
+        return luaL_error(L, "%s: %s", "set_damping", msg);
     }
-    return game_status(L, w, st, 2, "set_damping");
+    return 0;
 }
 
 /* body:damping(): linear, angular */
