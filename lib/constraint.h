@@ -57,11 +57,12 @@ typedef struct contact_constraint {
 
 /* Push-out bias of a penetrating row (separation s <= 0; a speculative row,
  * s > 0, takes CONTACT_SPECULATIVE_BIAS instead). `soft` selects the soft
- * spring's rate over Baumgarte's beta / h past the slop; both are capped at
+ * spring's rate over Baumgarte's beta / h; both act on the overlap past the
+ * slop only (linear_slop means the same in every mode) and are capped at
  * the push-out speed (neg_push = -push_max). Written over any number type:
  * the scalar passes give dmax/dmin, the wide passes the lanes' max/min. */
 #define CONTACT_PUSH_BIAS(soft, s, bias_rate, baumgarte_rate, slop, neg_push, zero, MAX, MIN) \
-    ((soft) ? MAX((bias_rate) * (s), (neg_push))                                             \
+    ((soft) ? MAX((bias_rate) * MIN((s) + (slop), (zero)), (neg_push))                       \
             : MAX((baumgarte_rate) * MIN((s) + (slop), (zero)), (neg_push)))
 /* A speculative row (s > 0) arrives exactly at contact within the sub-step. */
 #define CONTACT_SPECULATIVE_BIAS(s, inv_h) ((s) * (inv_h))

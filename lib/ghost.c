@@ -10,7 +10,7 @@
  * normal i's body does reach farther than j's (so j's normal is not the
  * normal of a common surface). A ghost is left out of this step's solve;
  * the surface it lies under holds the body. A true step (a tile higher
- * than its neighbour by more than a tenth of the linear slop) or a wall
+ * than its neighbour by more than GHOST_STEP, 0.5 mm) or a wall
  * standing on the floor rises above the floor's plane and keeps its contact.
  *
  * Then the manifolds a dynamic body has with several static bodies on one
@@ -29,6 +29,10 @@
 #include "mesh.h"
 #include "heightfield.h"
 #include "triangle_contact.h"
+
+/* the smallest step between tiles that is a true step (a tenth of 5 mm,
+ * linear_slop's default once) */
+#define GHOST_STEP 0.0005
 
 #define GHOST_COS (1.0 - 1e-12) /* normals this close are one surface's (the reach test decides the rest) */
 
@@ -282,7 +286,7 @@ void world_remove_ghost_contacts(carom_world *w)
         e[n++] = g;
     }
     qsort(e, (size_t)n, sizeof *e, by_dynamic);
-    double tol = 0.1 * w->def.linear_slop;
+    double tol = GHOST_STEP;
     int removed = 0;
     for (int first = 0; first < n;) {
         int last = first + 1;

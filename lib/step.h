@@ -31,7 +31,7 @@ typedef struct step_context {
     softness static_soft;        /* against a static or kinematic body: twice as stiff */
     carom_position_correction correction;
     double push_max;             /* cap on the push-out speed */
-    double slop;                 /* allowed overlap (Baumgarte) */
+    double slop;                 /* overlap every correction mode leaves alone */
     double baumgarte_rate;       /* beta / h */
     int iterations, relax_iterations;
     int warm_starting, friction, restitution, shock_propagation;

@@ -18,7 +18,7 @@
  *
  * A pair already touching at the start is swept too (a resting body struck
  * downwards at 4000 m/s would otherwise end half a metre inside the floor):
- * it may sink at most linear_slop below where it started. A body stopped at
+ * it may sink at most TOI_SINK (5 mm) below where it started. A body stopped at
  * fraction f stays stopped there for later pairs; passes repeat until no
  * fraction changes (a box stopped by one body must stop the one behind it). */
 #include <stdlib.h>
@@ -29,6 +29,9 @@
 #include "toi.h"
 
 #define TOI_MAX_ITERATIONS 64
+/* how far a touching pair may sink within a step before its sweep stops it
+ * (the contact solve removes that overlap; linear_slop's default once) */
+#define TOI_SINK 0.005
 #define TOI_MAX_PASSES 32
 
 /* Thickness below which a shape can pass through others in one step. */
@@ -270,7 +273,7 @@ int world_continuous(carom_world *w, const step_context *step)
         fast[fast_count++] = i;
     }
     if (fast_count == 0) return 1;
-    toi_context ctx = {w, sweeps, fraction, -1, dmax(0.5 * w->def.linear_slop, 1e-4), dmax(w->def.linear_slop, 1e-4), 1};
+    toi_context ctx = {w, sweeps, fraction, -1, 0.5 * TOI_SINK, TOI_SINK, 1};
     for (int pass = 0; pass < TOI_MAX_PASSES && ctx.changed; pass++) {
         ctx.changed = 0;
         for (int k = 0; k < fast_count; k++) {

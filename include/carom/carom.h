@@ -132,7 +132,11 @@ typedef struct carom_world_def {
     double contact_damping_ratio;       /* 10 */
     double contact_push_max_velocity;   /* 3 m/s: cap on the speed of push-out */
     double baumgarte;                   /* 0.2: beta for BAUMGARTE correction */
-    double linear_slop;                 /* 0.005 m: allowed overlap */
+    double linear_slop;                 /* 0 m: the overlap position correction leaves alone, in
+                                           every mode: soft and Baumgarte push out only the
+                                           overlap beyond it (resting contacts sit that much
+                                           deeper; an n-box column settles n times it more).
+                                           Baumgarte jitters without one: use about 0.005 there */
     double speculative_distance;        /* 0.02 m: contacts exist this far before touching */
     carom_contact_model contact_model;  /* IMPULSE */
     double penalty_stiffness;           /* 0: auto (from contact_hertz and masses); else N/m */
@@ -183,7 +187,7 @@ static inline carom_world_def carom_world_def_default(void)
     d.contact_damping_ratio = 10.0;
     d.contact_push_max_velocity = 3.0;
     d.baumgarte = 0.2;
-    d.linear_slop = 0.005;
+    d.linear_slop = 0.0;
     d.speculative_distance = 0.02;
     d.contact_model = CAROM_CONTACT_IMPULSE;
     d.penalty_stiffness = 0.0;
