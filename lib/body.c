@@ -10,7 +10,7 @@
     X(friction) X(restitution) X(linear_damping) X(angular_damping) X(gravity_scale) \
     X(plane_normal) X(plane_offset) X(sleep_time) X(shapes) X(proxy) X(fat_box) X(user_data) \
     X(solver_index) X(category) X(filter_mask) X(group) \
-    X(previous_origin) X(previous_rotation) X(torque) X(rolling_resistance) X(combine) X(force_threshold)
+    X(previous_origin) X(previous_rotation) X(torque) X(rolling_resistance) X(combine) X(force_threshold) X(collided)
 
 static int grow_field(void **p, size_t elem, int new_cap)
 {

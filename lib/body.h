@@ -58,6 +58,9 @@ typedef struct body_store {
     int *group;
     vec3 *previous_origin;      /* the pose at the start of the last step (interpolation) */
     quat *previous_rotation;
+    xform *collided;            /* the pose the body's last pair update and collision test used (the
+                                 * start of its last awake step): never read by the step, only the
+                                 * snapshot's prediction of contact poses (lib/snapshot.c) */
     int *solver_index;          /* scratch during a step */
 } body_store;
 

@@ -366,6 +366,7 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->user_data[slot] = d.user_data;
     s->previous_origin[slot] = to_v3(d.position);
     s->previous_rotation[slot] = q;
+    s->collided[slot] = (xform){to_v3(d.position), q};
     s->category[slot] = d.category;
     s->filter_mask[slot] = d.mask;
     s->group[slot] = d.group;

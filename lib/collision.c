@@ -62,7 +62,7 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     for (int i = 0; i < s->count; i++) {
         if (s->type[i] == CAROM_BODY_STATIC || !(s->flags[i] & BODY_AWAKE)) continue;
         /* the frame and tight bounds once per body, for every pair it is in */
-        sc->pose[i] = body_xform(s, i);
+        sc->pose[i] = s->collided[i] = body_xform(s, i);
         sc->tight_box[i] = shape_aabb(&s->shapes[i], sc->pose[i]);
         aabb box = aabb_fatten(sc->tight_box[i], w->def.speculative_distance);
         /* bullets and fast bodies: the box covers this step's travel so their
