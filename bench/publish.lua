@@ -59,14 +59,83 @@ for _, name in ipairs{ "fast", "default", "accurate" } do
     cell("mass_ratio", function(p) return string.format("%.2g mm", 1000 * p.error) end),
     cell("gas", function(p) return string.format("energy %+.2f %%", 100 * (tonumber(p.extra) - 1)) end))
 end
-local begin_mark = "<!-- presets table: written by make bench (bench/publish.lua) -->"
-local end_mark = "<!-- end of presets table -->"
+-- the canonical scenes beside the peers, from the same run's peers.txt
+local function peers_table(path)
+  local f = io.open(path, "rb")
+  if not f then return nil end
+  local cells, engines, seen, machine = {}, {}, {}, "?"
+  for line in f:lines() do
+    machine = line:match("^machine: (.*)") or machine
+    local engine, scene, ms, metrics = line:match("^| (%S+)%s*| (%S+)%s*|%s*%d+ |%s*%d+ |%s*([%d.]+) | %S+%s*| (.*)$")
+    if engine and engine ~= "engine" then
+      local m = {}
+      for k, v in metrics:gmatch("(%S+)=(%S+)") do m[k] = v end
+      m.ms = tonumber(ms)
+      cells[engine .. "/" .. scene] = m
+      if not seen[engine] then seen[engine] = true; engines[#engines + 1] = engine end
+    end
+  end
+  f:close()
+  local order, names = { "carom_fast", "carom", "ode", "bullet", "box3d", "jolt" },
+    { carom_fast = "carom `fast`", carom = "carom default", ode = "ODE", bullet = "Bullet", box3d = "Box3D", jolt = "Jolt" }
+  local cols = {}
+  for _, e in ipairs(order) do if seen[e] then cols[#cols + 1] = e end end
+  local function ms(m) return m.ms < 0.1 and string.format("%.3f ms", m.ms) or string.format("%.2f ms", m.ms) end
+  local describe = {
+    pyramid = function(m) return (m.stands == "yes" and "stands" or "**collapses**") .. string.format(" (max_disp %.3g m)", m.max_disp_m) end,
+    pile = function(m) return string.format("KE %.2g J, pen %.2g m", m.final_ke_J, m.max_pen_m) ..
+      (m.escaped ~= "0" and (", " .. m.escaped .. " escaped") or "") end,
+    stack = function(m) return (m.stands == "yes" and "" or "**falls**, ") .. string.format("max_disp %.3g m", m.max_disp_m) end,
+    mass_ratio = function(m) return (m.holds == "yes" and "holds" or "**fails**") .. string.format(" (heavy at %.4f m of 1.5)", m.heavy_z_m) end,
+    bullet = function(m) return m.tunneled == "no" and string.format("stops (x %.4f)", m.final_x_m) or "**tunnels**" end,
+  }
+  local labels = { pyramid = "pyramid, 210 boxes", pile = "pile, 2000 bodies", stack = "stack, 10 boxes",
+                   mass_ratio = "mass ratio 1000:1", bullet = "bullet, 750 m/s" }
+  local head, rule = { "| scene |" }, { "|---|" }
+  for _, e in ipairs(cols) do head[#head + 1] = " " .. names[e] .. " |"; rule[#rule + 1] = "---|" end
+  local out = { table.concat(head), table.concat(rule) }
+  for _, scene in ipairs{ "pyramid", "pile", "stack", "mass_ratio", "bullet" } do
+    local row = { "| " .. labels[scene] .. " |" }
+    for _, e in ipairs(cols) do
+      local m = cells[e .. "/" .. scene]
+      row[#row + 1] = m and (" " .. ms(m) .. ", " .. describe[scene](m) .. " |") or " - |"
+    end
+    out[#out + 1] = table.concat(row)
+  end
+  -- ratios against the faster of the peers measured in this run
+  local ratio = {}
+  for _, scene in ipairs{ "pyramid", "pile" } do
+    local best, who
+    for _, e in ipairs(cols) do
+      local m = cells[e .. "/" .. scene]
+      if m and not e:match("^carom") and (not best or m.ms < best) then best, who = m.ms, e end
+    end
+    for _, e in ipairs{ "carom_fast", "carom" } do
+      local m = cells[e .. "/" .. scene]
+      if m and best then ratio[#ratio + 1] = string.format("%s %s %.2fx %s", scene, names[e], m.ms / best, names[who]) end
+    end
+  end
+  out[#out + 1] = ""
+  out[#out + 1] = "Machine: " .. machine .. ". Median ms/step of the run's rounds; sleeping off in every engine." ..
+    (#ratio > 0 and (" Against the faster peer in this run: " .. table.concat(ratio, "; ") .. ".") or "")
+  return out
+end
+
+local function replace_between(text, begin_mark, end_mark, body)
+  local a, b = text:find(begin_mark, 1, true)
+  local c = text:find(end_mark, 1, true)
+  assert(a and c and c > b, "publish: " .. readme .. " lacks the markers " .. begin_mark)
+  return text:sub(1, b) .. "\n" .. table.concat(body, "\n") .. "\n" .. text:sub(c)
+end
 local f = assert(io.open(readme, "rb"))
 local text = f:read("a"); f:close()
-local a, b = text:find(begin_mark, 1, true)
-local c, d = text:find(end_mark, 1, true)
-assert(a and c and c > b, "publish: " .. readme .. " has no presets table markers")
-text = text:sub(1, b) .. "\n" .. table.concat(lines, "\n") .. "\n" .. text:sub(c)
+text = replace_between(text, "<!-- presets table: written by make bench (bench/publish.lua) -->",
+                       "<!-- end of presets table -->", lines)
+local peers = peers_table(out .. "/peers.txt")
+if peers then
+  text = replace_between(text, "<!-- peers table: written by make bench (bench/publish.lua) -->",
+                         "<!-- end of peers table -->", peers)
+end
 f = assert(io.open(readme, "wb"))
 f:write(text); f:close()
 print(("publish: %s/ refreshed, %s presets table rewritten (%d sweep rows)"):format(docs, readme, #rows))

@@ -36,6 +36,13 @@ if pkg-config --exists ode bullet 2>/dev/null; then
 else
     mkdir -p peers/build && cp ../build/bench/bench_carom peers/build/
 fi
+# Box3D and Jolt join the same rounds where their harnesses are built
+# (peers/README.md); peers/run.sh runs every peers/build/bench_* it finds.
+for peer in box3d:${BOX3D_BENCH:-} jolt:${JOLT_BENCH:-}; do
+    name=${peer%%:*}; bin=${peer#*:}
+    rm -f "peers/build/bench_$name"
+    if [ -n "$bin" ] && [ -x "$bin" ]; then ln -s "$bin" "peers/build/bench_$name"; fi
+done
 if [ "$quick" = 1 ]; then
     RUNS=1 ./peers/run.sh | tee out/peers_quick.txt
     echo "bench-quick: bench/out/peers_quick.txt in $(elapsed) (one round; make bench for 3 rounds and the rest)"
