@@ -63,9 +63,10 @@ end
 local function peers_table(path)
   local f = io.open(path, "rb")
   if not f then return nil end
-  local cells, engines, seen, machine = {}, {}, {}, "?"
+  local cells, engines, seen, machine, load = {}, {}, {}, "?", nil
   for line in f:lines() do
     machine = line:match("^machine: (.*)") or machine
+    load = line:match("^load average %(1 min%) before / after the rounds: (.*)") or load
     local engine, scene, ms, metrics = line:match("^| (%S+)%s*| (%S+)%s*|%s*%d+ |%s*%d+ |%s*([%d.]+) | %S+%s*| (.*)$")
     if engine and engine ~= "engine" then
       local m = {}
@@ -116,7 +117,7 @@ local function peers_table(path)
     end
   end
   out[#out + 1] = ""
-  out[#out + 1] = "Machine: " .. machine .. ". Median ms/step of the run's rounds; sleeping off in every engine." ..
+  out[#out + 1] = "Machine: " .. machine .. (load and (", load average " .. load) or "") .. ". Median ms/step of the run's rounds; sleeping off in every engine." ..
     (#ratio > 0 and (" Against the faster peer in this run: " .. table.concat(ratio, "; ") .. ".") or "")
   return out
 end
