@@ -334,6 +334,100 @@ int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user)
     return leaf;
 }
 
+/* The k-th smallest of keys[ids[lo..hi)] (by key, then id) at position k, the
+ * smaller ones before it and the larger after (quickselect, middle pivot). */
+static int key_less(const double *key, int a, int b) { return key[a] < key[b] || (key[a] == key[b] && a < b); }
+static void select_kth(int *ids, const double *key, int lo, int hi, int k)
+{
+    while (hi - lo > 1) {
+        int pivot = ids[lo + (hi - lo) / 2], i = lo, j = hi - 1;
+        while (i <= j) {
+            while (key_less(key, ids[i], pivot)) i++;
+            while (key_less(key, pivot, ids[j])) j--;
+            if (i <= j) {
+                int t = ids[i];
+                ids[i] = ids[j];
+                ids[j] = t;
+                i++;
+                j--;
+            }
+        }
+        if (k <= j) hi = j + 1;
+        else if (k >= i) lo = i;
+        else return;
+    }
+}
+
+/* A subtree over the leaves ids[lo..hi): split at the median centre along
+ * the widest spread of centres. key is scratch, one per node id. */
+static int build_subtree(broadphase *bp, int *ids, double *key, int lo, int hi)
+{
+    bp_node *N = bp->nodes;
+    if (hi - lo == 1) return ids[lo];
+    vec3 cmin = v3_scale(v3_add(N[ids[lo]].box.lo, N[ids[lo]].box.hi), 0.5), cmax = cmin;
+    for (int i = lo + 1; i < hi; i++) {
+        vec3 c = v3_scale(v3_add(N[ids[i]].box.lo, N[ids[i]].box.hi), 0.5);
+        cmin = v3_min(cmin, c);
+        cmax = v3_max(cmax, c);
+    }
+    vec3 spread = v3_sub(cmax, cmin);
+    int axis = spread.x >= spread.y && spread.x >= spread.z ? 0 : spread.y >= spread.z ? 1 : 2;
+    for (int i = lo; i < hi; i++) {
+        aabb b = N[ids[i]].box;
+        key[ids[i]] = axis == 0 ? b.lo.x + b.hi.x : axis == 1 ? b.lo.y + b.hi.y : b.lo.z + b.hi.z;
+    }
+    int mid = lo + (hi - lo) / 2;
+    select_kth(ids, key, lo, hi, mid);
+    int a = build_subtree(bp, ids, key, lo, mid), b = build_subtree(bp, ids, key, mid, hi);
+    int parent = alloc_node(bp);
+    N = bp->nodes;
+    N[parent].child1 = a;
+    N[parent].child2 = b;
+    N[a].parent = N[b].parent = parent;
+    refit(N, parent);
+    return parent;
+}
+
+int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, const int *user, int n, int *proxy)
+{
+    if (n <= 0) return 1;
+    if (bp->proxy_count != 0 || n > INT_MAX / 2 - 1) return 0;
+    int *ids = malloc(sizeof *ids * (size_t)n);
+    if (!ids || !reserve_nodes(bp, 2 * n) ||
+        !array_reserve((void **)&bp->moved, &bp->move_capacity, n, sizeof *bp->moved)) {
+        free(ids);
+        return 0;
+    }
+    double *key = malloc(sizeof *key * (size_t)bp->capacity);
+    if (!key) {
+        free(ids);
+        return 0;
+    }
+    /* the leaves first, in the order given (lowest free ids first), then the inner nodes */
+    for (int i = 0; i < n; i++) {
+        int leaf = alloc_node(bp);
+        bp->nodes[leaf].box = box[i];
+        bp->leaves[leaf].user = user[i];
+        bp->leaves[leaf].move_slot = -1;
+        bp->leaves[leaf].tree = is_static[i] ? STATIC_TREE : MOVING_TREE;
+        bp->proxy_count++;
+        mark_moved(bp, leaf);
+        proxy[i] = leaf;
+    }
+    for (int tree = 0; tree < 2; tree++) {
+        int count = 0;
+        for (int i = 0; i < n; i++)
+            if (bp->leaves[proxy[i]].tree == tree) ids[count++] = proxy[i];
+        if (count == 0) continue;
+        int root = build_subtree(bp, ids, key, 0, count);
+        bp->nodes[root].parent = NULL_NODE;
+        bp->root[tree] = root;
+    }
+    free(key);
+    free(ids);
+    return 1;
+}
+
 void bp_destroy_proxy(broadphase *bp, int proxy)
 {
     assert(is_proxy(bp, proxy));

@@ -20,6 +20,11 @@ void bp_destroy(broadphase *bp);
  * (the caller fattens it). A new proxy counts as moved. */
 int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user);
 void bp_destroy_proxy(broadphase *bp, int proxy);
+/* Creates n proxies at once in a broadphase that has none (a snapshot's
+ * restore), each tree built top down (median splits) instead of one
+ * insertion at a time; proxy[i] gets box[i]'s id. Every new proxy counts as
+ * moved. Returns 0 when out of memory, changing nothing. */
+int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, const int *user, int n, int *proxy);
 /* Replaces the proxy's box and marks it moved. */
 void bp_move_proxy(broadphase *bp, int proxy, aabb box);
 aabb bp_get_aabb(const broadphase *bp, int proxy);

@@ -281,42 +281,70 @@ static void put_coded(writer *o, const double *v, const double *pred, int n)
         x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
         tag[i] = coded_tag(x[i]);
     }
-    unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX];
-    size_t len = 0;
-    for (int i = 0; i < n; i += 2) bytes[len++] = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
+    size_t len = (size_t)(n + 1) / 2;
+    for (int i = 0; i < n; i++) len += (size_t)(tag[i] <= 8 ? tag[i] : 16 - tag[i]);
+    if (o->pos + len > o->cap) { /* measuring, or out of room: only the size */
+        o->pos += len;
+        return;
+    }
+    /* built here with whole 8-byte stores (each value's bytes, then bytes the
+     * next one overwrites), then copied: the caller's buffer is written only
+     * up to the snapshot's size */
+    unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX + 8], *b = bytes;
+    for (int i = 0; i < n; i += 2) *b++ = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
     for (int i = 0; i < n; i++) {
         int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
-        for (int k = from; k < to; k++) bytes[len++] = (unsigned char)(x[i] >> (8 * k));
+        if (SNAP_HOST_LE) {
+            uint64_t v = x[i] >> (8 * from);
+            memcpy(b, &v, 8);
+            b += to - from;
+        } else {
+            for (int k = from; k < to; k++) *b++ = (unsigned char)(x[i] >> (8 * k));
+        }
     }
-    put_bytes(o, bytes, len);
+    memcpy(o->buf + o->pos, bytes, len);
+    o->pos += len;
 }
 
 /* The reader's side; every value decoded must be finite. */
 static void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
 {
     int tag[CODED_MAX];
+    size_t tags = (size_t)(n + 1) / 2;
+    for (int i = 0; i < n; i++) out[i] = 0;
+    if (!need(r, tags, what)) return;
+    const unsigned char *p = r->buf + r->pos;
     for (int i = 0; i < n; i += 2) {
-        unsigned b = get_u8(r, what);
+        unsigned b = p[i / 2];
         tag[i] = (int)(b & 15);
         if (i + 1 < n) tag[i + 1] = (int)(b >> 4);
-        else if (b >> 4 && !r->failed) bad(r, "%s: unused tag bits set", what);
+        else if (b >> 4) { bad(r, "%s: unused tag bits set", what); return; }
     }
+    r->pos += tags;
+    int len[CODED_MAX];
     size_t total = 0;
-    for (int i = 0; i < n; i++) total += (size_t)(tag[i] <= 8 ? tag[i] : 16 - tag[i]);
-    if (r->failed || !need(r, total, what)) {
-        for (int i = 0; i < n; i++) out[i] = 0;
-        return;
-    }
     for (int i = 0; i < n; i++) {
-        out[i] = 0;
-        if (r->failed) continue;
+        len[i] = tag[i] <= 8 ? tag[i] : 16 - tag[i];
+        total += (size_t)len[i];
+    }
+    if (!need(r, total, what)) return;
+    p = r->buf + r->pos;
+    r->pos += total;
+    const unsigned char *end = r->buf + r->size;
+    for (int i = 0; i < n; i++) {
         uint64_t x = 0;
-        int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
-        for (int k = from; k < to; k++) x |= (uint64_t)r->buf[r->pos++] << (8 * k);
-        if (coded_tag(x) != tag[i]) { bad(r, "%s: a coded double not in its shortest form", what); continue; }
+        if (SNAP_HOST_LE && end - p >= 8) { /* one load, the value's bytes kept */
+            memcpy(&x, p, 8);
+            if (len[i] < 8) x &= ((uint64_t)1 << (8 * len[i])) - 1;
+        } else {
+            for (int k = 0; k < len[i]; k++) x |= (uint64_t)p[k] << (8 * k);
+        }
+        if (tag[i] > 8) x <<= 8 * (tag[i] - 8);
+        p += len[i];
+        if (coded_tag(x) != tag[i]) { bad(r, "%s: a coded double not in its shortest form", what); return; }
         uint64_t bits = x ^ f64_bits(pred[i]);
+        if (((bits >> 52) & 0x7ff) == 0x7ff) { bad(r, "%s is not finite", what); return; }
         memcpy(&out[i], &bits, 8);
-        if (!isfinite(out[i])) bad(r, "%s is not finite", what);
     }
 }
 
@@ -794,10 +822,18 @@ static void write_class(writer *o, const body_store *s, int i)
     write_shape(o, &s->shapes[i]);
 }
 
+/* (the class table's own hash, not part of the format: eight bytes a step) */
 static uint64_t hash_bytes(const unsigned char *p, size_t n)
 {
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
+    uint64_t h = 0xcbf29ce484222325ULL ^ (uint64_t)n;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t v;
+        memcpy(&v, p + i, 8);
+        h = (h ^ v) * 0xff51afd7ed558ccdULL;
+        h ^= h >> 32;
+    }
+    for (; i < n; i++) h = (h ^ p[i]) * 0x100000001b3ULL;
     return h;
 }
 
@@ -821,12 +857,7 @@ static int build_classes(const body_store *s, class_table *t)
 {
     memset(t, 0, sizeof *t);
     int n = s->count;
-    size_t total = 0;
-    for (int i = 0; i < n; i++) {
-        writer m = {NULL, 0, 0};
-        write_class(&m, s, i);
-        total += m.pos;
-    }
+    size_t total = 4096; /* grown as the distinct classes need (each written once) */
     int cap = 16;
     while (cap < 2 * n) cap *= 2;
     int *slots = malloc(sizeof *slots * (size_t)cap);
@@ -846,6 +877,21 @@ static int build_classes(const body_store *s, class_table *t)
         size_t at = t->start[t->count];
         writer o = {t->bytes, total, at};
         write_class(&o, s, i);
+        if (o.pos > total) {
+            size_t grown = total;
+            while (grown < o.pos) grown *= 2;
+            unsigned char *more = realloc(t->bytes, grown);
+            if (!more) {
+                free(slots);
+                free(hashes);
+                class_table_free(t);
+                return 0;
+            }
+            t->bytes = more;
+            total = grown;
+            o = (writer){t->bytes, total, at};
+            write_class(&o, s, i);
+        }
         size_t len = o.pos - at;
         uint64_t h = hash_bytes(t->bytes + at, len);
         int k = (int)(h & (uint64_t)(cap - 1));
@@ -1321,6 +1367,18 @@ static int distinct_classes(reader *r, const body_class *k, int n)
     return 1;
 }
 
+/* "body <i>" (what its errors say), without snprintf's cost per body */
+static void body_label(char what[48], int i)
+{
+    char digits[12];
+    int n = 0;
+    unsigned v = (unsigned)i;
+    do digits[n++] = (char)('0' + v % 10); while ((v /= 10) != 0);
+    memcpy(what, "body ", 5);
+    for (int k = 0; k < n; k++) what[5 + k] = digits[n - 1 - k];
+    what[5 + n] = '\0';
+}
+
 static int read_bodies(reader *r, carom_world *w)
 {
     body_store *s = &w->bodies;
@@ -1357,7 +1415,7 @@ static int read_bodies(reader *r, carom_world *w)
     int classes_used = 0;
     for (int i = 0; i < count; i++) {
         char what[48];
-        snprintf(what, sizeof what, "body %d", i);
+        body_label(what, i);
         int bits = get_small(r, 0, REC_ALL, 0, what);
         int ci = get_small(r, 0, class_count - 1, 0, what);
         if (r->failed) break;
@@ -1643,13 +1701,16 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
         carom_world_destroy(w);
         return bad(&r, "%zu bytes left over after the sensor overlaps", size - r.pos), NULL;
     }
-    /* the broadphase, rebuilt from the stored bounds in slot order, with the moved set restored */
-    for (int i = 0; i < s->count; i++) {
-        s->proxy[i] = bp_create_proxy(w->bp, s->fat_box[i], s->type[i] == CAROM_BODY_STATIC, s->id_index[i]);
-        if (s->proxy[i] < 0) {
-            carom_world_destroy(w);
-            return bad(&r, "out of memory"), NULL;
-        }
+    /* the broadphase, built at once from the stored bounds (the trees' shape
+     * does not change what it reports), with the moved set restored */
+    int *is_static = malloc(sizeof *is_static * (size_t)(s->count > 0 ? s->count : 1));
+    ok = is_static != NULL;
+    for (int i = 0; ok && i < s->count; i++) is_static[i] = s->type[i] == CAROM_BODY_STATIC;
+    ok = ok && bp_create_proxies(w->bp, s->fat_box, is_static, s->id_index, s->count, s->proxy);
+    free(is_static);
+    if (!ok) {
+        carom_world_destroy(w);
+        return bad(&r, "out of memory"), NULL;
     }
     for (int i = 0; i < s->count; i++) {
         bp_set_moved(w->bp, s->proxy[i], s->solver_index[i]);

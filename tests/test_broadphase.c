@@ -383,6 +383,67 @@ static void test_static_and_moving_pairs(void **state)
     free(log.count);
 }
 
+/* bp_create_proxies (a snapshot's restore) against one insertion at a time:
+ * valid balanced trees, and the same pairs reported
+ * (against brute force) now and after some proxies move. */
+static void test_bulk_build_matches_insertion(void **state)
+{
+    (void)state;
+    enum { N = 700 };
+    static aabb box[N];
+    static int is_static[N], user[N], proxy[N], proxy_one[N];
+    unsigned seed = 2024;
+    for (int i = 0; i < N; i++) {
+        double r[6];
+        for (int k = 0; k < 6; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            r[k] = (double)(seed >> 8) / 16777216.0;
+        }
+        box[i] = box_at(v3(20 * r[0], 20 * r[1], 5 * r[2]), v3(0.1 + 0.6 * r[3], 0.1 + 0.6 * r[4], 0.1 + 0.6 * r[5]));
+        is_static[i] = i % 4 == 1;
+        user[i] = i;
+    }
+    broadphase *bulk = bp_create(), *one = bp_create();
+    assert_true(bp_create_proxies(bulk, box, is_static, user, N, proxy));
+    assert_int_equal(bp_create_proxies(bulk, box, is_static, user, N, proxy), 0); /* only into an empty one */
+    for (int i = 0; i < N; i++) assert_true((proxy_one[i] = bp_create_proxy(one, box[i], is_static[i], user[i])) >= 0);
+    for (int i = 0; i < N; i++) assert_int_equal(bp_get_user(bulk, proxy[i]), i);
+    assert_true(bp_validate(bulk));
+    assert_int_equal(bp_proxy_count(bulk), N);
+    /* median splits: height ceil(log2 n) for each tree */
+    assert_true(bp_tree_height(bulk, 0) <= 10 && bp_tree_height(bulk, 1) <= 8);
+    pair_log a, b;
+    log_init(&a, N);
+    log_init(&b, N);
+    for (int round = 0; round < 2; round++) {
+        log_clear(&a);
+        log_clear(&b);
+        bp_update_pairs(bulk, log_pair, &a);
+        bp_update_pairs(one, log_pair, &b);
+        assert_int_equal(a.self_pairs + a.out_of_range, 0);
+        for (int i = 0; i < N; i++)
+            for (int j = i + 1; j < N; j++) {
+                int overlap = box[i].lo.x <= box[j].hi.x && box[j].lo.x <= box[i].hi.x && box[i].lo.y <= box[j].hi.y &&
+                              box[j].lo.y <= box[i].hi.y && box[i].lo.z <= box[j].hi.z && box[j].lo.z <= box[i].hi.z;
+                int expect = round == 0 ? overlap && !(is_static[i] && is_static[j]) : -1;
+                if (expect >= 0) assert_int_equal(reported(&a, i, j), expect);
+                assert_int_equal(reported(&a, i, j), reported(&b, i, j));
+            }
+        /* every seventh proxy moves by a box size */
+        for (int i = 0; i < N; i += 7) {
+            box[i] = box_at(v3_add(v3_scale(v3_add(box[i].lo, box[i].hi), 0.5), v3(0.5, -0.3, 0.2)),
+                            v3_scale(v3_sub(box[i].hi, box[i].lo), 0.5));
+            bp_move_proxy(bulk, proxy[i], box[i]);
+            bp_move_proxy(one, proxy_one[i], box[i]);
+        }
+    }
+    assert_true(bp_validate(bulk));
+    free(a.count);
+    free(b.count);
+    bp_destroy(bulk);
+    bp_destroy(one);
+}
+
 static void test_destroy_removes_from_moved_buffer(void **state)
 {
     (void)state;
@@ -602,6 +663,7 @@ int main(void)
         cmocka_unit_test(test_random_edits_sparse),
         cmocka_unit_test(test_random_edits_dense),
         cmocka_unit_test(test_static_and_moving_pairs),
+        cmocka_unit_test(test_bulk_build_matches_insertion),
         cmocka_unit_test(test_destroy_removes_from_moved_buffer),
         cmocka_unit_test(test_ray_cast_by_hand),
         cmocka_unit_test(test_nested_boxes_deep_tree),
