@@ -5,7 +5,10 @@
  * and the tunnelling check: bodies whose centre ended below the surface (a
  * ray cast down from above finds the surface), and the deepest overlap at
  * the end against the speculative distance.
- * Usage: terrain [steps] (default 600: 10 s at 60 Hz). */
+ * Also the deepest overlap of any body with the ground while the layers
+ * land (every step, from the bodies' contacts with the ground).
+ * Usage: terrain [steps [preset [mesh|field]]] (default 600 steps: 10 s at
+ * 60 Hz, every preset, both grounds). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -16,7 +19,15 @@
 
 #define BODIES 1000
 
-static double hill(double x, double y) { return 1.2 * sin(0.21 * x) * cos(0.17 * y) + 0.4 * sin(0.05 * x + 0.3); }
+/* TERRAIN_FLAT=1 (a bench switch, not a library one): flat ground, and
+ * ground "plane" runs the same drop on a plane for comparison */
+static int flat_ground(void) { const char *f = getenv("TERRAIN_FLAT"); return f && *f == '1'; }
+
+static double hill(double x, double y)
+{
+    if (flat_ground()) return 0;
+    return 1.2 * sin(0.21 * x) * cos(0.17 * y) + 0.4 * sin(0.05 * x + 0.3);
+}
 
 static double now_ms(void)
 {
@@ -89,6 +100,14 @@ static carom_body_id add_field_terrain(carom_world *w)
     return id;
 }
 
+static carom_body_id add_plane(carom_world *w)
+{
+    carom_body_def bd = carom_body_def_default();
+    bd.type = CAROM_BODY_STATIC;
+    bd.shape = carom_shape_plane(0, 0, 1, 0);
+    return carom_body_create(w, &bd);
+}
+
 static void add_bodies(carom_world *w, carom_body_id *ids)
 {
     static const double hull_pts[24] = {0.25, 0, 0, -0.2, 0.1, 0, 0, 0.25, 0.05, 0, -0.22, 0.02,
@@ -130,19 +149,31 @@ static void run(const char *preset, int field, int steps)
     carom_world_def_apply_preset(&wd, preset);
     carom_world *w = carom_world_create(&wd);
     double t0 = now_ms();
-    carom_body_id ground = field ? add_field_terrain(w) : add_mesh_terrain(w);
+    carom_body_id ground = field == 2 ? add_plane(w) : field ? add_field_terrain(w) : add_mesh_terrain(w);
     double build_ms = now_ms() - t0;
     if (carom_body_id_is_null(ground)) { printf("terrain: %s\n", carom_world_last_error(w)); exit(1); }
     static carom_body_id ids[BODIES];
     add_bodies(w, ids);
     double *ms = malloc(sizeof *ms * (size_t)steps);
-    double cpu0 = cpu_ms();
+    double cpu_ms_total = 0, landing = 0;
+    int landing_step = -1;
     for (int i = 0; i < steps; i++) {
-        double a = now_ms();
+        double a = now_ms(), c0 = cpu_ms();
         carom_world_step(w, 1.0 / 60.0);
         ms[i] = now_ms() - a;
+        cpu_ms_total += cpu_ms() - c0;
+        /* outside the timing: the deepest contact with the ground */
+        for (int k = 0; k < BODIES; k++) {
+            carom_contact_info info[8];
+            int n = carom_body_get_contacts(w, ids[k], info, 8);
+            for (int q = 0; q < n && q < 8; q++)
+                if (carom_body_id_equal(info[q].other, ground) && -info[q].separation > landing) {
+                    landing = -info[q].separation;
+                    landing_step = i;
+                }
+        }
     }
-    double cpu_per_step = (cpu_ms() - cpu0) / steps;
+    double cpu_per_step = cpu_ms_total / steps;
     qsort(ms, (size_t)steps, sizeof *ms, cmp);
     /* tunnelling: a centre below the surface, found by a ray cast down */
     int below = 0, missing = 0;
@@ -169,10 +200,12 @@ static void run(const char *preset, int field, int steps)
     carom_world_get_stats(w, &st);
     double pen = carom_world_measure_max_penetration(w);
     printf("%-8s %-11s build %7.1f ms  ms/step median %6.2f  p90 %6.2f  max %6.2f  awake %4d  "
-           "centres below the surface %d (deepest %.3f m)%s  deepest overlap %.4f m (speculative %.3f)  cpu ms/step mean %.2f\n",
-           preset, field ? "heightfield" : "mesh", build_ms, ms[steps / 2], ms[steps * 9 / 10], ms[steps - 1],
+           "centres below the surface %d (deepest %.3f m)%s  deepest overlap %.4f m (speculative %.3f)  cpu ms/step mean %.2f  "
+           "deepest ground overlap while landing %.4f m (step %d)\n",
+           preset, field == 2 ? "plane" : field ? "heightfield" : "mesh", build_ms, ms[steps / 2], ms[steps * 9 / 10], ms[steps - 1],
            st.awake_bodies, below, worst, missing ? " (some off the terrain)" : "", pen, wd.speculative_distance,
-           cpu_per_step);
+           cpu_per_step, landing, landing_step);
+    fflush(stdout);
     free(ms);
     carom_world_destroy(w);
 }
@@ -185,6 +218,10 @@ int main(int argc, char **argv)
            BODIES, steps);
     const char *presets[3] = {"fast", "default", "accurate"};
     for (int p = 0; p < 3; p++)
-        for (int f = 0; f < 2; f++) run(presets[p], f, steps);
+        for (int f = 0; f < 3; f++) {
+            if (argc > 2 && strcmp(argv[2], presets[p]) != 0) continue;
+            if (f == 2 ? !(argc > 3 && strcmp(argv[3], "plane") == 0) : argc > 3 && strcmp(argv[3], f ? "field" : "mesh") != 0) continue;
+            run(presets[p], f, steps);
+        }
     return 0;
 }
