@@ -21,6 +21,7 @@
  * and a wall two. */
 #include <stdlib.h>
 #include <string.h>
+#include "gjk.h"
 #include "manifold.h"
 #include "mesh.h"
 #include "heightfield.h"
@@ -198,6 +199,52 @@ static int face_contact_active(const vec3 v[3], vec3 n, unsigned active, vec3 fn
     return edge_faces_normal(v, n, active, on[0] ? 0 : on[1] ? 1 : 2, fn);
 }
 
+/* No axis separates the shape from the triangle by more than the
+ * look-ahead, yet neither face nor edge pair gave a point: beside the
+ * triangle, its nearest features are a vertex and an edge or two vertices
+ * (axes the separating-axis test does not try). The closest points (GJK
+ * on the true shape) give one point, from an active edge or vertex whose
+ * part of the Gauss map holds the normal. */
+static void look_ahead_point(const vec3 v[3], vec3 n, unsigned active, const shape *s, xform xs, double spec, manifold *m)
+{
+    if (!(active & 7u)) return; /* every edge internal: the neighbours' faces hold the shape */
+    vec3 local[3] = {v3(0, 0, 0), v3_sub(v[1], v[0]), v3_sub(v[2], v[0])};
+    gjk_proxy pt = {NULL, local, 3, {v3(0, 0, 0), q_identity()}};
+    gjk_proxy ps = {s, NULL, 0, {v3_sub(xs.p, v[0]), xs.q}};
+    gjk_result r = gjk_distance(&pt, &ps);
+    if (r.overlap || !(r.distance > 0) || !(r.distance < spec)) return;
+    vec3 nrm = r.normal, q = r.point_a;
+    double dist = r.distance;
+    if (!(v3_dot(nrm, n) >= 0)) {
+        /* below the triangle's plane: the one-sided triangle is the prism
+         * under it, whose side walls face along the plane; the room along
+         * the normal turned into the plane (both shapes' extents along it) */
+        nrm = v3_madd(nrm, -v3_dot(nrm, n), n);
+        if (!(v3_len2(nrm) > 1e-18)) return;
+        nrm = v3_normalize(nrm);
+        int top = 0;
+        for (int k = 1; k < 3; k++)
+            if (v3_dot(nrm, local[k]) > v3_dot(nrm, local[top])) top = k;
+        q = local[top];
+        vec3 low = xf_point(ps.x, shape_support_local(s, q_inv_rotate(xs.q, v3_neg(nrm))));
+        dist = v3_dot(nrm, v3_sub(low, q));
+        if (!(dist > 0) || !(dist < spec)) return;
+    }
+    double scale = v3_len(local[1]) + v3_len(local[2]);
+    int on[3], count = 0;
+    for (int k = 0; k < 3; k++) count += on[k] = v3_dot(edge_side(local, n, k), v3_sub(q, local[k])) >= -1e-9 * scale;
+    int ok = 0;
+    vec3 fn = v3_neg(nrm);
+    if (count == 1) ok = edge_faces_normal(local, n, active, on[0] ? 0 : on[1] ? 1 : 2, fn);
+    else if (count >= 2) {
+        int i = on[0] && on[1] ? 1 : on[1] && on[2] ? 2 : 0;
+        ok = edge_faces_normal(local, n, active, i, fn) || edge_faces_normal(local, n, active, (i + 2) % 3, fn);
+    }
+    if (!ok) return; /* over the face (the face contact's) or an internal feature (the neighbour's) */
+    m->normal = nrm;
+    push_point(m, v3_add(v[0], v3_madd(q, 0.5 * dist, nrm)), dist, 0x7000u | (uint32_t)(on[0] | on[1] << 1 | on[2] << 2));
+}
+
 /* A polytope p (built from shape s at xs; edge faces filled) against the triangle. */
 static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const poly *p, const shape *s, xform xs,
                               double spec, manifold *m)
@@ -276,6 +323,7 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
         if (alt.count > 0 && !face_contact_active(v, n, active, p->fn[best_f], &alt, !beside)) alt.count = 0;
     }
     if (alt.count > 0) *m = alt;
+    if (m->count == 0) look_ahead_point(v, n, active, s, xs, spec, m);
     /* apart: points clipped to a reference face can miss the nearest corner
      * of the other side; the separating axes bound the distance from below,
      * so no point may claim more room than they do. Overlapping on every
