@@ -152,9 +152,11 @@ static void test_dumbbell_rolls_as_analytic(void **state)
     (void)state;
     const double r = 0.15, L = 0.4, a = 0.03, h = 0.3, rho = 1000;
     double thetas[2] = {0.15, 0.3};
-    for (int k = 0; k < 2; k++) {
-        double th = thetas[k];
-        carom_world *w = world_default();
+    static const char *presets[3] = {"fast", "default", "accurate"};
+    for (int k = 0; k < 6; k++) {
+        double th = thetas[k % 2];
+        const char *preset = presets[k / 2];
+        carom_world *w = world_preset(preset, 1);
         carom_body_def pd = carom_body_def_default();
         pd.type = CAROM_BODY_STATIC;
         pd.shape = carom_shape_plane(sin(th), 0, cos(th), 0); /* descends along +x */
@@ -175,18 +177,21 @@ static void test_dumbbell_rolls_as_analytic(void **state)
         double acc = 9.81 * sin(th) / (1 + iaxis / (m * r * r));
         double s = (p1.x - p0.x) * cos(th) - (p1.z - p0.z) * sin(th);
         double want = 0.5 * acc * T * T;
-        printf("  dumbbell on %.2f rad: %.4f m down the slope (analytic %.4f), sideways %.2g m\n", th, s, want, p1.y - p0.y);
+        printf("  dumbbell on %.2f rad (%s): %.4f m down the slope (analytic %.4f), sideways %.2g m\n", th, preset, s, want,
+               p1.y - p0.y);
         assert_true(fabs(s - want) <= 0.01 * want);
         assert_true(fabs(p1.y - p0.y) <= 1e-3 * want); /* the 0.1 % of the path */
         carom_world_destroy(w);
     }
 }
 
-/* A table (a top and four legs) on a flat mesh floor stays put for 10 s. */
+/* A table (a top and four legs) on a flat mesh floor stays put for 10 s, at every preset. */
 static void test_table_stands_on_mesh(void **state)
 {
     (void)state;
-    carom_world *w = world_default();
+    static const char *presets[3] = {"fast", "default", "accurate"};
+    for (int k = 0; k < 3; k++) {
+    carom_world *w = world_preset(presets[k], 1);
     double *v; int *t; int nv, nt;
     scene_grid(10, 1.0, 0.0, 5u, &v, &nv, &t, &nt);
     carom_vec3 o = {0, 0, 0};
@@ -215,9 +220,10 @@ static void test_table_stands_on_mesh(void **state)
         double d = sqrt((p.x - p0.x) * (p.x - p0.x) + (p.y - p0.y) * (p.y - p0.y) + (p.z - p0.z) * (p.z - p0.z));
         if (d > worst) worst = d;
     }
-    printf("  table on a mesh: largest move in 10 s %.3g m\n", worst);
+    printf("  table on a mesh (%s): largest move in 10 s %.3g m\n", presets[k], worst);
     assert_true(worst <= 1e-3);
     carom_world_destroy(w);
+    }
 }
 
 static void test_child_in_ray_casts_and_events(void **state)

@@ -607,9 +607,10 @@ static void add_incline(carom_world *w, double theta)
 }
 
 /* Distance travelled down the slope in time T from rest. */
-static double incline_run(double theta, int sphere, double mu, double T)
+static double incline_run(const char *preset, double theta, int sphere, double mu, double T)
 {
     carom_world_def wd = carom_world_def_default();
+    assert_int_equal(carom_world_def_apply_preset(&wd, preset), CAROM_OK);
     carom_world *w = carom_world_create(&wd);
     add_incline(w, theta);
     carom_body_def bd = carom_body_def_default();
@@ -639,16 +640,18 @@ static void test_incline_analytic(void **state)
     (void)state;
     const double g = 9.81, T = 2.0;
     double angles[] = {0.2, 0.35};
-    for (int k = 0; k < 2; k++) {
-        double th = angles[k];
+    static const char *presets[3] = {"fast", "default", "accurate"};
+    for (int k = 0; k < 6; k++) {
+        double th = angles[k % 2];
+        const char *preset = presets[k / 2];
         /* rolling without slipping: a = 5/7 g sin (needs mu >= 2/7 tan) */
-        double s_roll = incline_run(th, 1, 0.6, T), a_roll = 5.0 / 7.0 * g * sin(th);
+        double s_roll = incline_run(preset, th, 1, 0.6, T), a_roll = 5.0 / 7.0 * g * sin(th);
         /* sliding box: a = g (sin - mu cos) */
         double mu = 0.1;
-        double s_slide = incline_run(th, 0, mu, T), a_slide = g * (sin(th) - mu * cos(th));
+        double s_slide = incline_run(preset, th, 0, mu, T), a_slide = g * (sin(th) - mu * cos(th));
         double e_roll = 0.5 * a_roll * T * T, e_slide = 0.5 * a_slide * T * T;
-        printf("  incline %.2f rad: sphere %.4f m (analytic %.4f), box %.4f m (analytic %.4f)\n", th, s_roll, e_roll,
-               s_slide, e_slide);
+        printf("  incline %.2f rad (%s): sphere %.4f m (analytic %.4f), box %.4f m (analytic %.4f)\n", th, preset, s_roll,
+               e_roll, s_slide, e_slide);
         assert_true(fabs(s_roll - e_roll) <= 0.01 * e_roll);
         assert_true(fabs(s_slide - e_slide) <= 0.01 * e_slide);
     }
@@ -659,8 +662,11 @@ static void test_incline_analytic(void **state)
 static void test_bullet_one_triangle_wall(void **state)
 {
     (void)state;
-    for (int two_sided = 0; two_sided < 2; two_sided++) {
+    static const char *presets[3] = {"fast", "default", "accurate"};
+    for (int k = 0; k < 6; k++) {
+        int two_sided = k % 2;
         carom_world_def wd = carom_world_def_default();
+        assert_int_equal(carom_world_def_apply_preset(&wd, presets[k / 2]), CAROM_OK);
         wd.gravity.z = 0;
         carom_world *w = carom_world_create(&wd);
         /* a triangle in the plane x = 0 facing -x (towards the bullet) */
@@ -682,7 +688,7 @@ static void test_bullet_one_triangle_wall(void **state)
         for (int i = 0; i < 60; i++) assert_int_equal(carom_world_step(w, 1.0 / 60.0), CAROM_OK);
         carom_vec3 p;
         carom_body_get_position(w, b, &p);
-        printf("  bullet (two_sided %d) ends at x = %.4f\n", two_sided, p.x);
+        printf("  bullet (%s, two_sided %d) ends at x = %.4f\n", presets[k / 2], two_sided, p.x);
         assert_true(p.x < 0);
         carom_world_destroy(w);
     }
