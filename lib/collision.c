@@ -87,62 +87,63 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
 }
 
 /* B's frame expressed in A's. */
-static xform relative_pose(xform xa, xform xb)
+static xform relative_pose(const xform *xa, const xform *xb)
 {
-    xform r = {xf_inv_point(xa, xb.p), q_mul(q_conj(xa.q), xb.q)};
+    xform r = {xf_inv_point(*xa, xb->p), q_mul(q_conj(xa->q), xb->q)};
     return r;
 }
 
 /* Keeps last manifold when B's material at every contact point has moved less
  * than `reuse` relative to A since the manifold was computed (a resting pair
  * moves micrometres a step): each separation changes by the normal component
- * of that motion, exact to first order, the point by half of it. Returns 1
- * when the manifold was kept. */
-static int reuse_manifold(const contact *c, contact_data *d, xform xa, xform xb, double reuse)
+ * of that motion, exact to first order, the point by half of it. now: B's
+ * frame in A's (relative_pose). Returns 1 when the manifold was kept. */
+static int reuse_manifold(const contact *c, contact_data *d, const xform *xa, const xform *now, double reuse)
 {
     if (!(c->flags & CONTACT_REUSABLE) || d->m.count == 0 || !(reuse > 0)) return 0;
-    xform now = relative_pose(xa, xb);
-    if (v3_len2(v3_sub(now.p, c->rel_pose.p)) > reuse * reuse) return 0;
+    if (v3_len2(v3_sub(now->p, c->rel_pose.p)) > reuse * reuse) return 0;
     /* B's motion in A's frame since then, x -> R x + t, as a matrix: one
      * product per point instead of two quaternion rotations */
-    quat dq = q_mul(now.q, q_conj(c->rel_pose.q));
+    quat dq = q_mul(now->q, q_conj(c->rel_pose.q));
     mat3 R = m3_from_quat(dq);
-    vec3 t = v3_sub(now.p, q_rotate(dq, c->rel_pose.p));
+    vec3 t = v3_sub(now->p, q_rotate(dq, c->rel_pose.p));
     vec3 moved[MANIFOLD_MAX_POINTS];
     for (int i = 0; i < d->m.count; i++) {
         vec3 then = d->state[i].local_a; /* B's material there moves to R then + t */
         moved[i] = v3_sub(v3_add(m3_mulv(R, then), t), then);
         if (!(v3_len2(moved[i]) <= reuse * reuse)) return 0;
     }
-    d->m.normal = q_rotate(xa.q, d->normal_a);
+    d->m.normal = q_rotate(xa->q, d->normal_a);
     for (int i = 0; i < d->m.count; i++) {
         d->m.points[i].separation = d->state[i].separation + v3_dot(d->normal_a, moved[i]);
-        d->m.points[i].point = xf_point(xa, v3_madd(d->state[i].local_a, 0.5, moved[i]));
+        d->m.points[i].point = xf_point(*xa, v3_madd(d->state[i].local_a, 0.5, moved[i]));
     }
     return 1;
 }
 
 /* Largest distance any point of B can have moved relative to A since
  * rel_pose: B's origin's travel plus the chord of B's rotation at its reach. */
-static double travel_bound(const contact *c, xform now)
+static double travel_bound(const contact *c, const xform *now)
 {
-    quat q0 = c->rel_pose.q, q1 = now.q;
+    quat q0 = c->rel_pose.q, q1 = now->q;
     double d = q0.w * q1.w + q0.x * q1.x + q0.y * q1.y + q0.z * q1.z;
-    return v3_len(v3_sub(now.p, c->rel_pose.p)) + 2.0 * c->reach_b * sqrt(dmax(0.0, 1.0 - d * d));
+    return v3_len(v3_sub(now->p, c->rel_pose.p)) + 2.0 * c->reach_b * sqrt(dmax(0.0, 1.0 - d * d));
 }
 
 /* A pair found apart by more than the look-ahead stays apart (no narrowphase)
- * while the motion since cannot have closed the gap down to the look-ahead. */
-static int still_apart(const contact *c, xform xa, xform xb, double spec)
+ * while the motion since cannot have closed the gap down to the look-ahead.
+ * now: B's frame in A's. */
+static int still_apart(const contact *c, const xform *now, double spec)
 {
     if (!(c->flags & CONTACT_APART)) return 0;
-    return travel_bound(c, relative_pose(xa, xb)) < c->gap - spec;
+    return travel_bound(c, now) < c->gap - spec;
 }
 
 /* Records the pose a freshly computed manifold belongs to (see reuse_manifold,
  * still_apart). An empty one stores the separation of the two shapes along
- * its normal, a lower bound on their distance. */
-static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa, const shape *sb, xform xb, double spec)
+ * its normal, a lower bound on their distance. now: B's frame in A's. */
+static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa, const shape *sb, xform xb, double spec,
+                          const xform *now)
 {
     c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
     if (d->m.count == 0) {
@@ -152,13 +153,13 @@ static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa
         vec3 low_b = xf_point(xb, shape_support_local(sb, q_inv_rotate(xb.q, v3_neg(n))));
         double gap = v3_dot(n, v3_sub(low_b, top_a));
         if (!(gap > spec) || !isfinite(gap)) return;
-        c->rel_pose = relative_pose(xa, xb);
+        c->rel_pose = *now;
         c->gap = gap;
         c->reach_b = shape_bounding_radius(sb);
         c->flags |= CONTACT_APART;
         return;
     }
-    c->rel_pose = relative_pose(xa, xb);
+    c->rel_pose = *now;
     d->normal_a = q_inv_rotate(xa.q, d->m.normal);
     for (int i = 0; i < d->m.count; i++) d->state[i].separation = d->m.points[i].separation;
     c->flags |= CONTACT_REUSABLE;
@@ -259,73 +260,80 @@ static int body_awake(const body_store *s, int slot)
     return s->type[slot] != CAROM_BODY_STATIC && (s->flags[slot] & BODY_AWAKE);
 }
 
-/* The narrowphase of a plain (not composite) pair: its manifold refreshed,
- * kept, or known empty; returns 1 when it has points. ba, bb: the bounds the
- * look-ahead is tested on; spec: the look-ahead. Reads and writes contact i
- * alone (and reads the bodies), so pairs run in any order and at once. */
-static int narrow_contact(carom_world *w, int i, aabb ba, aabb bb, double spec, double reuse, int bounds_overlap)
+/* The look-ahead of a pair: a fast pair looks ahead by its closing travel
+ * this step. The square root only where the travel can exceed the
+ * speculative distance (below 0.9 of it in squares, far outside round-off). */
+static double pair_look_ahead(const carom_world *w, const step_context *ctx, int a, int b)
+{
+    const body_store *s = &w->bodies;
+    double speculative = w->def.speculative_distance;
+    double spec = speculative;
+    vec3 dv = v3_sub(s->velocity[a], s->velocity[b]);
+    double l2 = v3_len2(dv) * (ctx->dt * ctx->dt);
+    if (l2 < 0.81 * (spec * spec)) return spec;
+    double closing = v3_len(dv) * ctx->dt;
+    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
+    return spec;
+}
+
+/* The narrowphase of a plain (not composite) pair whose fat bounds overlap:
+ * its manifold refreshed, kept, or known empty; returns 1 when it has
+ * points. a, b: the bodies' slots, awake_a, awake_b: body_awake of each.
+ * Reads and writes contact i alone (and reads the bodies), so pairs run in
+ * any order and at once. */
+static int narrow_contact(carom_world *w, const step_context *ctx, int i, int a, int b, int awake_a, int awake_b,
+                          double reuse)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
     contact *c = &cs->items[i];
     contact_data *d = &cs->data[i];
-    int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-    int awake_a = body_awake(s, a), awake_b = body_awake(s, b);
-    int touching = 0; /* known without reading the manifold where possible */
-    if (bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb)) {
-        xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
-        if (reuse_manifold(c, d, xa, xb, reuse)) {
-            touching = 1; /* kept: ids, impulses and feature cache stay as they were */
-        } else if (still_apart(c, xa, xb, spec)) {
-            touching = 0;
-        } else if (d->m.count == 0) {
-            /* most pairs near contact: nothing to carry over, nothing to copy */
-            manifold none;
-            none.count = 0;
-            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-            if (d->m.count > 0) contact_match_points(d, &none, d->state, xa);
-            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-            touching = d->m.count > 0;
-        } else {
-            manifold old_m = d->m;
-            contact_point_state old_state[MANIFOLD_MAX_POINTS];
-            memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
-            collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &c->cache, &d->m);
-            if (d->m.count > 0) contact_match_points(d, &old_m, old_state, xa);
-            remember_pose(c, d, &s->shapes[a], xa, &s->shapes[b], xb, spec);
-            touching = d->m.count > 0;
-        }
-    } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
-        d->m.count = 0;
+    double spec = pair_look_ahead(w, ctx, a, b);
+    /* bounds farther apart than the look-ahead: no point can be within it
+     * (the gap between boxes bounds the distance), so skip the narrowphase */
+    const aabb *ba = awake_a ? &sc->tight_box[a] : &s->fat_box[a], *bb = awake_b ? &sc->tight_box[b] : &s->fat_box[b];
+    if (!aabb_overlap(aabb_fatten(*ba, spec), *bb)) {
+        if (c->flags & CONTACT_TOUCHING) d->m.count = 0; /* else the manifold is already empty */
+        return 0;
     }
-    return touching;
-}
-
-/* The look-ahead of a pair: a fast pair looks ahead by its closing travel this step. */
-static double pair_look_ahead(const carom_world *w, const step_context *ctx, int a, int b)
-{
-    const body_store *s = &w->bodies;
-    double speculative = w->def.speculative_distance;
-    double spec = speculative;
-    double closing = v3_len(v3_sub(s->velocity[a], s->velocity[b])) * ctx->dt;
-    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
-    return spec;
+    xform xa_own, xb_own;
+    const xform *xa = awake_a ? &sc->pose[a] : (xa_own = body_xform(s, a), &xa_own);
+    const xform *xb = awake_b ? &sc->pose[b] : (xb_own = body_xform(s, b), &xb_own);
+    xform now = relative_pose(xa, xb);
+    if (reuse_manifold(c, d, xa, &now, reuse)) return 1; /* kept: ids, impulses and feature cache stay as they were */
+    if (still_apart(c, &now, spec)) return 0;
+    if (d->m.count == 0) {
+        /* most pairs near contact: nothing to carry over, nothing to copy */
+        manifold none;
+        none.count = 0;
+        collide(&s->shapes[a], *xa, &s->shapes[b], *xb, spec, &c->cache, &d->m);
+        if (d->m.count > 0) contact_match_points(d, &none, d->state, *xa);
+    } else {
+        manifold old_m = d->m;
+        contact_point_state old_state[MANIFOLD_MAX_POINTS];
+        memcpy(old_state, d->state, sizeof old_state[0] * (size_t)old_m.count);
+        collide(&s->shapes[a], *xa, &s->shapes[b], *xb, spec, &c->cache, &d->m);
+        if (d->m.count > 0) contact_match_points(d, &old_m, old_state, *xa);
+    }
+    remember_pose(c, d, &s->shapes[a], *xa, &s->shapes[b], *xb, spec, &now);
+    return d->m.count > 0;
 }
 
 /* Refreshes the manifold(s) of contact i (a pair's own contact, sub 0, with
  * at least one body awake), raises its begin/end events, lists it as
  * touching and wakes a sleeping body it touches (counted in *woken). A pair
  * whose bounds no longer overlap is removed when may_remove (returns 0:
- * index i now holds another contact), else only emptied. */
-static int update_contact(carom_world *w, const step_context *ctx, int i, double reuse, int may_remove, int *woken)
+ * index i now holds another contact), else only emptied. a, b: the
+ * bodies' slots. */
+static int update_contact(carom_world *w, const step_context *ctx, int i, int a, int b, double reuse, int may_remove,
+                          int *woken)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
     contact *c = &cs->items[i];
     contact_data *d = &cs->data[i];
-    int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
     int awake_a = body_awake(s, a), awake_b = body_awake(s, b);
     int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
     int bounds_overlap = aabb_overlap(s->fat_box[a], s->fat_box[b]);
@@ -334,12 +342,11 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
         contact_remove(cs, i);
         return 0;
     }
-    double spec = pair_look_ahead(w, ctx, a, b);
-    /* bounds farther apart than the look-ahead: no point can be within it
-     * (the gap between boxes bounds the distance), so skip the narrowphase */
-    aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
     int touching = 0; /* known without reading the manifold where possible */
     if (composite) {
+        double spec = pair_look_ahead(w, ctx, a, b);
+        /* bounds farther apart than the look-ahead: no point can be within it */
+        aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
         xform xa = awake_a ? sc->pose[a] : body_xform(s, a), xb = awake_b ? sc->pose[b] : body_xform(s, b);
         int near = bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb);
         touching = collide_composite_pair(w, i, xa, xb, spec, near);
@@ -366,8 +373,10 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, double
     if (c->flags & CONTACT_PRECOMPUTED) {
         touching = (c->flags & CONTACT_PRECOMPUTED_TOUCHING) != 0; /* precompute_range did the work */
         c->flags &= ~(uint32_t)(CONTACT_PRECOMPUTED | CONTACT_PRECOMPUTED_TOUCHING);
-    } else {
-        touching = narrow_contact(w, i, ba, bb, spec, reuse, bounds_overlap);
+    } else if (bounds_overlap) {
+        touching = narrow_contact(w, ctx, i, a, b, awake_a, awake_b, reuse);
+    } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
+        d->m.count = 0;
     }
     int was = (c->flags & CONTACT_TOUCHING) != 0;
     c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING)) |
@@ -403,7 +412,6 @@ static void precompute_range(int begin, int end, int worker, void *p)
     carom_world *w = j->w;
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
-    step_scratch *sc = &w->scratch;
     (void)worker;
     for (int i = begin; i < end; i++) {
         contact *c = &cs->items[i];
@@ -415,9 +423,7 @@ static void precompute_range(int begin, int end, int worker, void *p)
             continue;
         if (shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b])) continue;
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || !filter_bits_allow(s, a, b)) continue;
-        double spec = pair_look_ahead(w, j->ctx, a, b);
-        aabb ba = awake_a ? sc->tight_box[a] : s->fat_box[a], bb = awake_b ? sc->tight_box[b] : s->fat_box[b];
-        int touching = narrow_contact(w, i, ba, bb, spec, j->reuse, 1);
+        int touching = narrow_contact(w, j->ctx, i, a, b, awake_a, awake_b, j->reuse);
         c->flags |= CONTACT_PRECOMPUTED | (touching ? CONTACT_PRECOMPUTED_TOUCHING : 0u);
     }
 }
@@ -467,7 +473,7 @@ int world_collide(carom_world *w, const step_context *ctx)
             i++;
             continue;
         }
-        if (update_contact(w, ctx, i, reuse, 1, &woken)) i++;
+        if (update_contact(w, ctx, i, a, b, reuse, 1, &woken)) i++;
     }
     /* Waking spreads through touching pairs whatever their order in the
      * cache: a body woken above takes part in all its pairs this step, so it
@@ -485,7 +491,7 @@ int world_collide(carom_world *w, const step_context *ctx)
             if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, sc->touching_count + 1,
                                sizeof *sc->touching))
                 return 0;
-            update_contact(w, ctx, i, reuse, 0, &woken);
+            update_contact(w, ctx, i, s->ids[c->id_a].slot, s->ids[c->id_b].slot, reuse, 0, &woken);
         }
     }
     /* the extra manifolds of the mesh pairs computed above */

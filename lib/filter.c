@@ -3,13 +3,6 @@
 #include "filter.h"
 #include "world.h"
 
-int filter_bits_allow(const body_store *s, int a, int b)
-{
-    int ga = s->group[a], gb = s->group[b];
-    if (ga != 0 && ga == gb) return ga > 0; /* a shared group decides alone */
-    return (s->category[a] & s->filter_mask[b]) != 0 && (s->category[b] & s->filter_mask[a]) != 0;
-}
-
 int filter_pair_allowed(carom_world *w, int slot_a, int slot_b)
 {
     const body_store *s = &w->bodies;

@@ -5,8 +5,14 @@
 
 #include "body.h"
 
-/* 1 when the bits and groups of the bodies at slots a and b let them touch. */
-int filter_bits_allow(const body_store *s, int a, int b);
+/* 1 when the bits and groups of the bodies at slots a and b let them touch
+ * (inline: the collision stage asks it of every pair every step). */
+static inline int filter_bits_allow(const body_store *s, int a, int b)
+{
+    int ga = s->group[a], gb = s->group[b];
+    if (ga != 0 && ga == gb) return ga > 0; /* a shared group decides alone */
+    return (s->category[a] & s->filter_mask[b]) != 0 && (s->category[b] & s->filter_mask[a]) != 0;
+}
 /* The bits, then the world's pair filter for a pair with no contact yet
  * (one that exists was admitted when it began): what continuous collision
  * asks before it sweeps one body against another. */
