@@ -255,6 +255,16 @@ static void wake_for_step(carom_world *w, int slot)
     w->scratch.tight_box[slot] = shape_aabb(&s->shapes[slot], w->scratch.pose[slot]);
 }
 
+/* Lists contact i (bodies at slots a, b) as touching this step, and among
+ * the mixed ones when one body is dynamic and the other not. The caller
+ * reserved both lists. */
+static void list_touching(step_scratch *sc, const body_store *s, int i, int a, int b)
+{
+    if ((s->type[a] == CAROM_BODY_DYNAMIC) != (s->type[b] == CAROM_BODY_DYNAMIC))
+        sc->mixed[sc->mixed_count++] = sc->touching_count;
+    sc->touching[sc->touching_count++] = i;
+}
+
 static int body_awake(const body_store *s, int slot)
 {
     return s->type[slot] != CAROM_BODY_STATIC && (s->flags[slot] & BODY_AWAKE);
@@ -367,7 +377,7 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, int a,
             }
             events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
         }
-        if (d->m.count > 0) sc->touching[sc->touching_count++] = i;
+        if (d->m.count > 0) list_touching(sc, s, i, a, b);
         return 1;
     }
     if (c->flags & CONTACT_PRECOMPUTED) {
@@ -388,7 +398,7 @@ static int update_contact(carom_world *w, const step_context *ctx, int i, int a,
     }
     if (touching && !was) events_touch(w, i, CAROM_EVENT_BEGIN);
     else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
-    if (touching) sc->touching[sc->touching_count++] = i;
+    if (touching) list_touching(sc, s, i, a, b);
     return 1;
 }
 
@@ -437,9 +447,12 @@ int world_collide(carom_world *w, const step_context *ctx)
      * contact while the manifold is kept */
     double reuse = dmin(w->def.contact_reuse_distance, w->def.speculative_distance);
     sc->touching_count = 0;
+    sc->mixed_count = 0;
     sc->asleep_pair_count = 0;
     /* at most every contact is touching (or asleep): reserve once, so nothing below can fail */
-    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
+    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching) ||
+        !array_reserve((void **)&sc->mixed, &sc->mixed_capacity, cs->count, sizeof *sc->mixed))
+        return 0;
     if (!array_reserve((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
         return 0;
     /* on one worker the pass below does the same work in place */
@@ -489,18 +502,22 @@ int world_collide(carom_world *w, const step_context *ctx)
             if (!body_awake(s, s->ids[c->id_a].slot) && !body_awake(s, s->ids[c->id_b].slot)) { k++; continue; }
             sc->asleep_pairs[k] = sc->asleep_pairs[--sc->asleep_pair_count];
             if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, sc->touching_count + 1,
-                               sizeof *sc->touching))
+                               sizeof *sc->touching) ||
+                !array_reserve((void **)&sc->mixed, &sc->mixed_capacity, sc->touching_count + 1, sizeof *sc->mixed))
                 return 0;
             update_contact(w, ctx, i, s->ids[c->id_a].slot, s->ids[c->id_b].slot, reuse, 0, &woken);
         }
     }
     /* the extra manifolds of the mesh pairs computed above */
-    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching)) return 0;
+    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching) ||
+        !array_reserve((void **)&sc->mixed, &sc->mixed_capacity, cs->count, sizeof *sc->mixed))
+        return 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         if (!c->sub || !(c->flags & CONTACT_TOUCHING)) continue;
         int primary = contact_find(cs, c->id_a, c->id_b);
-        if (primary >= 0 && (cs->items[primary].flags & CONTACT_SIM)) sc->touching[sc->touching_count++] = i;
+        if (primary >= 0 && (cs->items[primary].flags & CONTACT_SIM))
+            list_touching(sc, s, i, s->ids[c->id_a].slot, s->ids[c->id_b].slot);
     }
     return 1;
 }

@@ -264,22 +264,18 @@ void world_remove_ghost_contacts(carom_world *w)
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
     sc->merged_count = 0;
-    int n = 0;
-    for (int k = 0; k < sc->touching_count; k++) {
-        const contact *c = &cs->items[sc->touching[k]];
-        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        n += (s->type[a] == CAROM_BODY_DYNAMIC) != (s->type[b] == CAROM_BODY_DYNAMIC);
-    }
+    /* the collision stage listed the touching contacts between a dynamic
+     * body and a static or kinematic one (step_scratch.mixed) */
+    int n = sc->mixed_count;
     if (n < 2) return;
     ghost_entry *e = malloc(sizeof *e * (size_t)n);
     if (!e) return; /* out of memory: the ghosts stay, as they would without this pass */
     n = 0;
-    for (int k = 0; k < sc->touching_count; k++) {
+    for (int m = 0; m < sc->mixed_count; m++) {
+        int k = sc->mixed[m];
         int ci = sc->touching[k];
         const contact *c = &cs->items[ci];
-        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        int da = s->type[a] == CAROM_BODY_DYNAMIC, db = s->type[b] == CAROM_BODY_DYNAMIC;
-        if (da == db) continue;
+        int da = s->type[s->ids[c->id_a].slot] == CAROM_BODY_DYNAMIC;
         /* the manifold's normal points from a to b */
         vec3 normal = da ? v3_neg(cs->data[ci].m.normal) : cs->data[ci].m.normal;
         ghost_entry g = {da ? c->id_a : c->id_b, da ? c->id_b : c->id_a, ci, k, normal};
@@ -291,9 +287,10 @@ void world_remove_ghost_contacts(carom_world *w)
     for (int first = 0; first < n;) {
         int last = first + 1;
         while (last < n && e[last].dynamic == e[first].dynamic) last++;
+        if (last - first < 2) { first = last; continue; } /* one manifold: no pair to compare */
         int dyn = s->ids[e[first].dynamic].slot;
         aabb near = aabb_fatten(shape_aabb(&s->shapes[dyn], body_xform(s, dyn)), w->def.speculative_distance);
-        for (int j = first; j < last && last - first > 1; j++) {
+        for (int j = first; j < last; j++) {
             const ghost_entry *gj = &e[j];
             int sj = s->ids[gj->other].slot;
             xform xj = body_xform(s, sj);

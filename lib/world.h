@@ -40,6 +40,9 @@ typedef struct step_scratch {
     int slot_capacity;
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;
+    int *mixed;                 /* indices into touching of the contacts between a dynamic body and a
+                                   static or kinematic one (the seam pass reads these alone) */
+    int mixed_count, mixed_capacity;
     impact_memory impact;       /* impact.c's per-body states and pairs */
     int *asleep_pairs;          /* contacts both of whose bodies slept when the collision pass met them */
     int asleep_pair_count, asleep_pair_capacity;
