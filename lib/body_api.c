@@ -71,7 +71,8 @@ static int check_shape(carom_world *w, const carom_shape_def *sd, carom_body_typ
 
 /* A dynamic body's mass and inertia (fn names the caller): inside the ranges
  * the solver's products and inverses stay finite. The principal moments are
- * bounded through the trace (>= the largest) and det / trace^2 (<= the smallest). */
+ * bounded through the trace (>= the largest) and det / trace^2 (<= the smallest),
+ * their spread through trace^3 / det (ranges.h). */
 static int check_mass_props(const carom_world *w, const mass_props *mp, const char *fn)
 {
     if (!(mp->mass >= RANGE_MASS_MIN && mp->mass <= RANGE_MASS_MAX))
@@ -82,6 +83,11 @@ static int check_mass_props(const carom_world *w, const mass_props *mp, const ch
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
                           "%s: principal moments of inertia in [%g, %g] kg m^2 must lie within [1e-24, 1e30] "
                           "(the body is too small, too thin or too light for its mass)", fn, smallest, trace), 0;
+    double anisotropy = trace * trace * trace / m3_det(mp->inertia);
+    if (!(anisotropy <= RANGE_ANISOTROPY_MAX))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                          "%s: inertia anisotropy trace^3/det %g is above 1e12 (a largest/smallest principal moment "
+                          "ratio above about 1e11: the body is too thin for double precision)", fn, anisotropy), 0;
     return 1;
 }
 

@@ -22,6 +22,16 @@
 #define RANGE_DENSITY_MAX 1e9       /* kg/m^3 */
 #define RANGE_INERTIA_MIN 1e-24     /* kg m^2: smallest principal moment (a lower bound of it) */
 #define RANGE_INERTIA_MAX 1e30      /* kg m^2: largest principal moment (an upper bound of it) */
+/* trace^3 / det of the inertia: 27 for a sphere, about 8 I_max / I_min for a
+ * needle (always between I_max / I_min and 27 times it). The world-frame
+ * inverse inertia R diag(1/I) R^T carries a rounding of a few ulps of 1/I_min
+ * in every term, and its smallest true value is 1/I_max: above about 1e15
+ * (1/eps) the tensor is noise along the stiff axes, indefinite, and impacts
+ * add energy (a 2.6e-5 m x 84 km capsule, ratio 1.7e18: its transverse
+ * 1/I of 1.3e-6 computed as -1.1e-5, rounding of 5e-18 of 1/I_min; it went
+ * 9.6e166 m into the ground in 17 steps). At 1e12 (ratio <= 1.25e11 for a
+ * needle) that rounding is 6e-7 of 1/I_max (2.8e-5 at a whole ulp). */
+#define RANGE_ANISOTROPY_MAX 1e12
 #define RANGE_SPEED_MAX 1e9         /* m/s and rad/s: ceiling of max_linear/angular_speed */
 #define RANGE_ACCELERATION_MAX 1e9  /* m/s^2: |gravity| x |gravity_scale|, |force| / mass */
 #define RANGE_GRAVITY_MAX 1e4       /* m/s^2: |world gravity| */
@@ -34,6 +44,11 @@
 #define RANGE_HERTZ_MAX 1e6
 #define RANGE_RATIO_MAX 1e6         /* contact_damping_ratio */
 #define RANGE_PENALTY_MAX 1e20      /* penalty_stiffness (N/m), penalty_damping (N s/m) */
+/* N s: a contact point's warm-start normal impulse (the tangent's parts within
+ * RANGE_FRICTION_MAX times it): 1e6 times the largest change of momentum of
+ * one body, 1e15 kg x 2e9 m/s = 2e24, leaving room for the weight of a deep
+ * stack; the solver never stores a negative normal impulse */
+#define RANGE_IMPULSE_MAX 1e30
 #define RANGE_NORMAL_MIN 1e-12      /* length of a plane normal or a lock_to_plane normal */
 
 #endif

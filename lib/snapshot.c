@@ -1269,6 +1269,8 @@ static int read_class(reader *r, body_class *k)
             return bad(r, "a body class's mass %g is outside [1e-9, 1e15] kg", k->mass);
         if (!(trace <= RANGE_INERTIA_MAX && m3_det(I) / (trace * trace) >= RANGE_INERTIA_MIN))
             return bad(r, "a body class's inertia is outside [1e-24, 1e30] kg m^2");
+        if (!(trace * trace * trace / m3_det(I) <= RANGE_ANISOTROPY_MAX))
+            return bad(r, "a body class's inertia anisotropy trace^3/det is above 1e12");
         /* an inertia tensor is symmetric with diagonal terms >= 0 and none
          * above the trace (a fuzzed one with a term of -5e84 passed the two
          * checks above and sent bodies to inf) */
@@ -1645,6 +1647,12 @@ static int read_contacts(reader *r, carom_world *w)
             p->point = get_coded_v3(r, point, "manifold point");
             p->separation = get_coded1(r, separation, "manifold point");
             memcpy(last, cur, sizeof cur);
+            /* warm-start impulses the solver could have stored (a fuzzed one of
+             * 1.7e307 N s threw a hull 1.9e303 m in one step) */
+            if (!r->failed && !(st->normal_impulse >= 0 && st->normal_impulse <= RANGE_IMPULSE_MAX &&
+                                fabs(st->tangent_impulse[0]) <= RANGE_FRICTION_MAX * RANGE_IMPULSE_MAX &&
+                                fabs(st->tangent_impulse[1]) <= RANGE_FRICTION_MAX * RANGE_IMPULSE_MAX))
+                return bad(r, "contact %d: a warm-start impulse outside [0, 1e30] N s (tangent 1e33)", i);
         }
     }
     return !r->failed;

@@ -178,8 +178,11 @@ static void walk_edge(const edge *e)
 
 static int b_radius(carom_body_def *d, double v) { d->shape = carom_shape_sphere(v); return 1; }
 static int b_box(carom_body_def *d, double v) { d->shape = carom_shape_box(v, 0.2, 0.2); return 1; }
+/* a long body's cross-section keeps its inertia anisotropy (trace^3/det) within
+ * 1e12: a 1e6 m beam 0.2 m thick would be 1.3e14 (see test_anisotropy_edge) */
+static int b_box_long(carom_body_def *d, double v) { d->shape = carom_shape_box(v, 10, 10); return 1; }
 static int b_capsule_r(carom_body_def *d, double v) { d->shape = carom_shape_capsule(v, 0.2); return 1; }
-static int b_capsule_h(carom_body_def *d, double v) { d->shape = carom_shape_capsule(0.2, v); return 1; }
+static int b_capsule_h(carom_body_def *d, double v) { d->shape = carom_shape_capsule(10, v); return 1; }
 static int b_cylinder_r(carom_body_def *d, double v) { d->shape = carom_shape_cylinder(v, 0.2); return 1; }
 static int b_cylinder_h(carom_body_def *d, double v) { d->shape = carom_shape_cylinder(0.2, v); return 1; }
 static int b_mass(carom_body_def *d, double v) { d->mass = v; return 1; }
@@ -210,7 +213,7 @@ static const edge edges[] = {
     {"sphere radius, low", 1e-6, -1, "[1e-6, 1e6] m", NULL, b_radius, NULL, 1.0 / 60},
     {"sphere radius, high", 1e6, +1, "[1e-6, 1e6] m", NULL, b_radius, NULL, 1.0 / 60},
     {"box half extent, low", 1e-6, -1, "[1e-6, 1e6] m", NULL, b_box, NULL, 1.0 / 60},
-    {"box half extent, high", 1e6, +1, "[1e-6, 1e6] m", NULL, b_box, NULL, 1.0 / 60},
+    {"box half extent, high", 1e6, +1, "[1e-6, 1e6] m", NULL, b_box_long, NULL, 1.0 / 60},
     {"capsule radius", 1e-6, -1, "[1e-6, 1e6] m", NULL, b_capsule_r, NULL, 1.0 / 60},
     {"capsule half height", 1e6, +1, "[1e-6, 1e6] m", NULL, b_capsule_h, NULL, 1.0 / 60},
     {"cylinder radius", 1e6, +1, "[1e-6, 1e6] m", NULL, b_cylinder_r, NULL, 1.0 / 60},
@@ -245,6 +248,47 @@ static void test_range_edges(void **state)
         print_message("edge: %s\n", edges[i].name);
         walk_edge(&edges[i]);
     }
+}
+
+/* The inertia anisotropy edge (trace^3/det <= 1e12): a 2 kg capsule of half
+ * height 1 m as thin as it may be. Its moments are m r^2 / 2 about the axis
+ * and m (2h)^2 / 12 across (to r / h ~ 1e-6), so trace^3/det = 8 I_t / I_a
+ * (1 + I_a / 2 I_t)^3 = 16 h^2 / (3 r^2) and the edge is r = h sqrt(16 / 3e12):
+ * the radius where creation starts to be refused lies there, and the edge is
+ * walked from it like the others. */
+static int b_needle(carom_body_def *d, double v) { d->shape = carom_shape_capsule(v, 1.0); return 1; }
+
+static int needle_accepted(double r)
+{
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    carom_body_def d = carom_body_def_default();
+    d.mass = 2;
+    b_needle(&d, r);
+    int ok = !carom_body_id_is_null(carom_body_create(w, &d));
+    if (!ok && !strstr(carom_world_last_error(w), "above 1e12")) fail_msg("r %g: \"%s\"", r, carom_world_last_error(w));
+    carom_world_destroy(w);
+    return ok;
+}
+
+static void test_anisotropy_edge(void **state)
+{
+    (void)state;
+    double lo = 1e-6, hi = 1e-5; /* refused, accepted */
+    assert_false(needle_accepted(lo));
+    assert_true(needle_accepted(hi));
+    while (nextafter(lo, hi) < hi) {
+        double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) mid = nextafter(lo, hi);
+        if (needle_accepted(mid)) hi = mid;
+        else lo = mid;
+    }
+    double analytic = sqrt(16.0 / 3e12);
+    print_message("thinnest accepted 1 m capsule: r = %.9g m (analytic %.9g m)\n", hi, analytic);
+    assert_true(fabs(hi / analytic - 1) < 1e-5);
+    edge e = {"inertia anisotropy (capsule radius)", hi, -1, "above 1e12", NULL, b_needle, NULL, 1.0 / 60};
+    walk_edge(&e);
 }
 
 /* ---- the findings of issue 17 ------------------------------------------------ */
@@ -428,6 +472,7 @@ int main(void)
         cmocka_unit_test(test_finding4_huge_sphere_hits),
         cmocka_unit_test(test_finding5_tiny_time_step),
         cmocka_unit_test(test_range_edges),
+        cmocka_unit_test(test_anisotropy_edge),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
