@@ -16,6 +16,8 @@ FUZZ_SMOKE_RUNS ?= 300
 FUZZ_LIMIT    = -max_total_time=$(FUZZ_SECONDS)
 FUZZ_NAMES   := api scene lua snapshot
 FUZZ_DIR     := build/fuzz-clang
+# the working corpus (grown inputs; kept between runs, out of git)
+FUZZ_CORPUS  ?= $(FUZZ_DIR)/corpus
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all
 FUZZ_CFLAGS   = -std=c99 -Wall -Wextra -Werror -g -O1 -fno-omit-frame-pointer -ffp-contract=off $(FUZZ_SAN) \
                 -DCAROM_BUILDING -Iinclude -Ilib -Ifuzz $(CCD_CFLAGS) $(LUA_CFLAGS)
@@ -24,6 +26,9 @@ FUZZ_LUA_OBJ := $(patsubst lua/%.c,$(FUZZ_DIR)/lua/%.o,$(LUA_SRC))
 FUZZ_BIN     := $(patsubst %,$(FUZZ_DIR)/fuzz_%,$(FUZZ_NAMES))
 
 .PHONY: fuzz fuzz-build fuzz-smoke check-fuzz-replay
+# The objects are intermediates of the fuzz_% pattern rule: without this make
+# deletes all of them after linking and rebuilds every one on the next run.
+.SECONDARY: $(FUZZ_LIB_OBJ) $(FUZZ_LUA_OBJ)
 
 $(FUZZ_DIR)/lib/%.o: lib/%.c $(wildcard lib/*.h) $(wildcard include/carom/*.h)
 	@mkdir -p $(dir $@)
@@ -42,23 +47,24 @@ fuzz-build: deps
 	$(MAKE) --no-print-directory $(FUZZ_BIN)
 
 # Each harness runs FUZZ_SECONDS on a working corpus seeded from fuzz/corpus
-# (new inputs stay in build/fuzz-clang/); a crash stops it with the input saved in
+# (new inputs stay in $(FUZZ_CORPUS)); a crash stops it with the input saved in
 # build/fuzz-clang/artifacts/: copy it to fuzz/regressions/<name>/ once fixed.
 fuzz: fuzz-build
 	@set -e; for n in $(FUZZ_NAMES); do \
-	    mkdir -p $(FUZZ_DIR)/corpus/$$n $(FUZZ_DIR)/artifacts/$$n fuzz/corpus/$$n; \
+	    mkdir -p $(FUZZ_CORPUS)/$$n $(FUZZ_DIR)/artifacts/$$n fuzz/corpus/$$n; \
 	    echo "== fuzz_$$n for $(FUZZ_SECONDS) s"; \
 	    log=$(FUZZ_DIR)/fuzz_$$n.log; \
 	    if ! ./$(FUZZ_DIR)/fuzz_$$n $(FUZZ_LIMIT) -timeout=20 -rss_limit_mb=2048 -max_len=65536 \
 	        -print_final_stats=1 -artifact_prefix=$(FUZZ_DIR)/artifacts/$$n/ \
-	        $(FUZZ_DIR)/corpus/$$n fuzz/corpus/$$n > $$log 2>&1; then \
+	        $(FUZZ_CORPUS)/$$n fuzz/corpus/$$n > $$log 2>&1; then \
 	        tail -40 $$log; echo "fuzz_$$n: crash, input saved in $(FUZZ_DIR)/artifacts/$$n/"; exit 1; fi; \
 	    grep -E "^#[0-9]+.*(DONE|cov:)" $$log | tail -1; grep -E "stat::number_of_executed_units|stat::peak_rss_mb" $$log; \
 	done; echo "make fuzz: no crash"
 
+# from the seeds alone, in a corpus of its own (the working corpus is kept)
 fuzz-smoke:
-	rm -rf $(FUZZ_DIR)/corpus
-	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_SMOKE) \
+	rm -rf $(FUZZ_DIR)/smoke-corpus
+	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_SMOKE) FUZZ_CORPUS=$(FUZZ_DIR)/smoke-corpus \
 	    FUZZ_LIMIT='-seed=1 -runs=$(FUZZ_SMOKE_RUNS) -max_total_time=600'
 
 # The harnesses as plain programs over files (fuzz/replay.c is their main).
