@@ -279,10 +279,61 @@ static void fill_constraints_range(int begin, int end, int worker, void *p)
     for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &j->cc[k], touching[k]);
 }
 
+/* The order the manifolds are solved in, from the geometry alone, so a scene
+ * gives the same results whatever order its bodies were created in (the
+ * contact set's order follows creation): bottom-up by the height of the
+ * manifold's centroid against gravity, then along two fixed horizontal axes
+ * (without gravity: along z, then x, y). Ties (two manifolds with one
+ * centroid) keep the contact set's order. Bottom-up is also the faster
+ * order for a stack: a reversed 10-box column at default ended 5.1 cm from
+ * its start in the creation order, 2.7 cm bottom-up (top-down: 2.9-3.4).
+ * This reorders step_scratch.touching in place: the seam pass (ghost.c) has
+ * already read step_scratch.mixed, whose indices into it go stale here. */
+typedef struct order_key { double k[3]; int contact; } order_key;
+static int by_order_key(const void *pa, const void *pb)
+{
+    const order_key *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++) {
+        if (a->k[i] < b->k[i]) return -1;
+        if (a->k[i] > b->k[i]) return 1;
+    }
+    return (a->contact > b->contact) - (a->contact < b->contact);
+}
+
+static int sort_touching(carom_world *w, const step_context *ctx)
+{
+    step_scratch *s = &w->scratch;
+    solver_memory *sm = &s->solver;
+    int n = s->touching_count;
+    if (n < 2) return 1;
+    if (!array_reserve(&sm->order, &sm->order_capacity, n, sizeof(order_key))) return 0;
+    order_key *keys = sm->order;
+    vec3 up = v3_len2(ctx->gravity) > 0.0 ? v3_normalize(v3_neg(ctx->gravity)) : v3(0, 0, 1);
+    vec3 e1, e2;
+    v3_basis(up, &e1, &e2);
+    int sorted = 1;
+    for (int k = 0; k < n; k++) {
+        const manifold *m = &w->contacts.data[s->touching[k]].m;
+        vec3 c = v3_zero();
+        for (int j = 0; j < m->count; j++) c = v3_add(c, m->points[j].point);
+        c = v3_scale(c, 1.0 / m->count);
+        keys[k].k[0] = v3_dot(c, up);
+        keys[k].k[1] = v3_dot(c, e1);
+        keys[k].k[2] = v3_dot(c, e2);
+        keys[k].contact = s->touching[k];
+        if (k > 0 && sorted && by_order_key(&keys[k - 1], &keys[k]) > 0) sorted = 0;
+    }
+    if (sorted) return 1;
+    qsort(keys, (size_t)n, sizeof *keys, by_order_key);
+    for (int k = 0; k < n; k++) s->touching[k] = keys[k].contact;
+    return 1;
+}
+
 static int build_constraints(carom_world *w, step_context *ctx, solver_work *work)
 {
     step_scratch *s = &w->scratch;
     const contact_set *cs = &w->contacts;
+    if (!sort_touching(w, ctx)) return 0;
     int ncon = s->touching_count, npoints = 0, nb = ctx->body_count;
     for (int c = 0; c < ncon; c++) npoints += cs->data[s->touching[c]].m.count;
     /* one block: constraints, then their points packed (most pairs of round
@@ -675,6 +726,7 @@ void solver_memory_free(solver_memory *m)
 {
     free(m->block);
     free(m->wide);
+    free(m->order);
     memset(m, 0, sizeof *m);
 }
 

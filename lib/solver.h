@@ -11,6 +11,8 @@ typedef struct solver_memory {
     int block_capacity;
     void *wide;                  /* solver_wide.c's batches */
     size_t wide_capacity;
+    void *order;                 /* the manifolds' solve-order keys (sort_touching) */
+    int order_capacity;
 } solver_memory;
 void solver_memory_free(solver_memory *m);
 
