@@ -1,5 +1,6 @@
 /* shape_def.c - validation of a public shape def and its conversion to the
  * internal shape (see shape_def.h). */
+#include <stdio.h>
 #include <string.h>
 #include "narrowphase.h"
 #include "ranges.h"
@@ -18,10 +19,11 @@ static int normal_ok(carom_vec3 n)
 
 #define LENGTH_RANGE "[1e-6, 1e6] m"
 
-static int check_shape(const carom_world *w, const carom_shape_def *sd, carom_body_type type, const char *fn)
+/* 1 if sd is a valid shape for a body of this type, else 0 with "fn: why" in msg. */
+static int check_shape(char *msg, size_t size, const carom_shape_def *sd, carom_body_type type, const char *fn)
 {
     /* (the messages are the body's: fn names the caller) */
-#define FAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
+#define FAIL(...) return snprintf(msg, size, __VA_ARGS__), 0
     switch (sd->type) {
     case CAROM_SHAPE_SPHERE:
         if (!length_ok(sd->radius)) FAIL("%s: sphere radius %g is outside " LENGTH_RANGE, fn, sd->radius);
@@ -74,15 +76,30 @@ static int check_shape(const carom_world *w, const carom_shape_def *sd, carom_bo
 carom_status shape_def_check(const carom_world *w, const carom_shape_def *sd, carom_body_type type, const char *fn)
 {
     if (!sd) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: shape is NULL", fn);
-    return check_shape(w, sd, type, fn) ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT;
+    char msg[WORLD_ERROR_SIZE];
+    if (!check_shape(msg, sizeof msg, sd, type, fn)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s", msg);
+    return CAROM_OK;
+}
+
+CAROM_API carom_status carom_shape_def_check(const carom_shape_def *def, carom_body_type type, char *msg, size_t msg_size)
+{
+    char buf[WORLD_ERROR_SIZE];
+    int ok = def != NULL;
+    if (!ok) snprintf(buf, sizeof buf, "shape_def_check: shape is NULL");
+    else if (type != CAROM_BODY_STATIC && type != CAROM_BODY_KINEMATIC && type != CAROM_BODY_DYNAMIC) {
+        snprintf(buf, sizeof buf, "shape_def_check: unknown body type %d", (int)type);
+        ok = 0;
+    } else ok = check_shape(buf, sizeof buf, def, type, "shape_def_check");
+    if (msg && msg_size) snprintf(msg, msg_size, "%s", ok ? "" : buf);
+    return ok ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT;
 }
 
 carom_status shape_from_def(const carom_world *w, const carom_shape_def *sd, carom_body_type type, const char *fn,
                             shape *s)
 {
     memset(s, 0, sizeof *s);
-    if (!sd) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: shape is NULL", fn);
-    if (!check_shape(w, sd, type, fn)) return CAROM_ERROR_INVALID_ARGUMENT;
+    carom_status st = shape_def_check(w, sd, type, fn);
+    if (st != CAROM_OK) return st;
     s->type = (int)sd->type;
     s->radius = sd->radius;
     s->half_height = sd->half_height;

@@ -4,6 +4,7 @@
  * name or by position (carom.capsule{0.1, 0.3}). A descriptor is validated
  * when made and never changes; add_body copies it into the world, so one
  * descriptor can serve many bodies. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -15,7 +16,6 @@ const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", 
 
 /* Largest hull input accepted here; the world refuses hulls whose result is
  * larger than its narrowphase holds, with its own message. */
-#define MAX_HULL_POINTS 100000
 
 clua_shape *clua_check_shape(lua_State *L, int arg, const char *fname)
 {
@@ -58,14 +58,22 @@ static void normalise_positions(lua_State *L, const char *fname, const char *con
     lua_replace(L, 1);
 }
 
-static double positive_field(lua_State *L, const char *fname, const char *key)
+static double required_field(lua_State *L, const char *fname, const char *key)
 {
     double v = 0;
     if (!clua_field_number(L, 1, fname, key, &v)) clua_arg_error(L, 1, fname, "%s is required", key);
-    if (!(v > 0)) clua_arg_error(L, 1, fname, "%s must be positive", key);
-    if (!(v >= RANGE_LENGTH_MIN && v <= RANGE_LENGTH_MAX))
-        clua_arg_error(L, 1, fname, "%s %g is outside the length range [1e-6, 1e6] m", key, v);
     return v;
+}
+
+/* The library's own check of the def (as carom_body_create applies it to a
+ * static body; the body's type is checked again there): its message, less
+ * the "shape_def_check: " prefix, as the argument error. */
+static void check_def(lua_State *L, const char *fname, const carom_shape_def *def)
+{
+    char msg[256];
+    if (carom_shape_def_check(def, CAROM_BODY_STATIC, msg, sizeof msg) == CAROM_OK) return;
+    const char *colon = strstr(msg, ": ");
+    clua_arg_error(L, 1, fname, "%s", colon ? colon + 2 : msg);
 }
 
 static int l_sphere(lua_State *L)
@@ -73,8 +81,9 @@ static int l_sphere(lua_State *L)
     static const char *const keys[] = {"radius", NULL};
     check_shape_args(L, "sphere", keys);
     normalise_positions(L, "sphere", keys);
-    double r = positive_field(L, "sphere", "radius");
-    new_shape(L)->def = carom_shape_sphere(r);
+    carom_shape_def def = carom_shape_sphere(required_field(L, "sphere", "radius"));
+    check_def(L, "sphere", &def);
+    new_shape(L)->def = def;
     return 1;
 }
 
@@ -85,11 +94,9 @@ static int l_box(lua_State *L)
     normalise_positions(L, "box", keys);
     carom_vec3 h;
     if (!clua_field_vec3(L, 1, "box", "half_extents", &h)) clua_arg_error(L, 1, "box", "half_extents is required");
-    if (!(h.x > 0 && h.y > 0 && h.z > 0)) clua_arg_error(L, 1, "box", "half_extents must be positive");
-    if (!(h.x >= RANGE_LENGTH_MIN && h.x <= RANGE_LENGTH_MAX && h.y >= RANGE_LENGTH_MIN && h.y <= RANGE_LENGTH_MAX &&
-          h.z >= RANGE_LENGTH_MIN && h.z <= RANGE_LENGTH_MAX))
-        clua_arg_error(L, 1, "box", "half_extents {%g, %g, %g} must each be in the length range [1e-6, 1e6] m", h.x, h.y, h.z);
-    new_shape(L)->def = carom_shape_box(h.x, h.y, h.z);
+    carom_shape_def def = carom_shape_box(h.x, h.y, h.z);
+    check_def(L, "box", &def);
+    new_shape(L)->def = def;
     return 1;
 }
 
@@ -98,9 +105,11 @@ static int round_shape(lua_State *L, const char *fname, int capsule)
     static const char *const keys[] = {"radius", "half_height", NULL};
     check_shape_args(L, fname, keys);
     normalise_positions(L, fname, keys);
-    double r = positive_field(L, fname, "radius");
-    double h = positive_field(L, fname, "half_height");
-    new_shape(L)->def = capsule ? carom_shape_capsule(r, h) : carom_shape_cylinder(r, h);
+    double r = required_field(L, fname, "radius");
+    double h = required_field(L, fname, "half_height");
+    carom_shape_def def = capsule ? carom_shape_capsule(r, h) : carom_shape_cylinder(r, h);
+    check_def(L, fname, &def);
+    new_shape(L)->def = def;
     return 1;
 }
 
@@ -130,10 +139,9 @@ static int l_hull(lua_State *L)
         points_index = lua_gettop(L);
     }
     lua_Integer n = (lua_Integer)lua_rawlen(L, points_index);
-    if (n < 4) clua_arg_error(L, 1, "hull", "a hull needs at least 4 points, got %d", (int)n);
-    if (n > MAX_HULL_POINTS) clua_arg_error(L, 1, "hull", "a hull takes at most %d points", MAX_HULL_POINTS);
+    if (n > INT_MAX / 3) clua_arg_error(L, 1, "hull", "%lld points are too many to read", (long long)n);
     clua_shape *s = new_shape(L); /* owns the array from here, so an error below cannot leak it */
-    s->points = malloc(sizeof(double) * 3 * (size_t)n);
+    s->points = malloc(sizeof(double) * 3 * (size_t)(n > 0 ? n : 1));
     if (!s->points) return luaL_error(L, "hull: out of memory");
     for (lua_Integer i = 0; i < n; i++) {
         lua_rawgeti(L, points_index, i + 1);
@@ -142,14 +150,13 @@ static int l_hull(lua_State *L)
             if (lua_rawgeti(L, -1, c + 1) != LUA_TNUMBER) clua_arg_error(L, 1, "hull", "point %d is not a vector of 3 numbers", (int)i + 1);
             double v = lua_tonumber(L, -1);
             if (!isfinite(v)) clua_arg_error(L, 1, "hull", "point %d is not finite", (int)i + 1);
-            if (!(fabs(v) <= RANGE_LENGTH_MAX))
-                clua_arg_error(L, 1, "hull", "point %d has coordinate %g; each must be within 1e6 m of the body origin", (int)i + 1, v);
             s->points[3 * i + c] = v;
             lua_pop(L, 1);
         }
         lua_pop(L, 1);
     }
     s->def = carom_shape_hull(s->points, (int)n);
+    check_def(L, "hull", &s->def);
     return 1;
 }
 
@@ -166,13 +173,9 @@ static int l_plane(lua_State *L)
     double offset = 0;
     clua_field_vec3(L, 1, "plane", "normal", &n);
     clua_field_number(L, 1, "plane", "offset", &offset);
-    if (n.x == 0 && n.y == 0 && n.z == 0) clua_arg_error(L, 1, "plane", "normal must not be zero");
-    double len = sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-    if (!isfinite(len)) clua_arg_error(L, 1, "plane", "normal is too long");
-    if (!(len >= RANGE_NORMAL_MIN)) clua_arg_error(L, 1, "plane", "normal is shorter than 1e-12");
-    if (!(fabs(offset / len) <= RANGE_COORDINATE_MAX))
-        clua_arg_error(L, 1, "plane", "offset %g is outside [-1e12, 1e12] m", offset / len);
-    new_shape(L)->def = carom_shape_plane(n.x, n.y, n.z, offset);
+    carom_shape_def def = carom_shape_plane(n.x, n.y, n.z, offset);
+    check_def(L, "plane", &def);
+    new_shape(L)->def = def;
     return 1;
 }
 

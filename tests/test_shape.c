@@ -13,6 +13,7 @@
 #include <string.h>
 #include <math.h>
 #include <cmocka.h>
+#include "carom/carom.h"
 #include "shape.h"
 #include "helpers.h"
 
@@ -1136,6 +1137,60 @@ static void test_ray_casts(void **state)
     check_miss(&p, v3(0, 0, 5), v3(0, 0, -1), 2.9, "plane beyond max_t");
 }
 
+/* ---- carom_shape_def_check: the rules body_create applies, alone ---------------- */
+
+/* For each def and body type: the check agrees with carom_body_create, an
+ * accepted def leaves msg empty, a refused one names the bad value. */
+static void test_shape_def_check(void **state)
+{
+    (void)state;
+    static const double tetra[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double far_tetra[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 2e6};
+    struct { carom_shape_def def; int ok_static, ok_dynamic; const char *text; } cases[] = {
+        {carom_shape_sphere(0.5), 1, 1, ""},
+        {carom_shape_sphere(-1), 0, 0, "sphere radius -1 is outside"},
+        {carom_shape_sphere(0), 0, 0, "sphere radius 0 is outside"},
+        {carom_shape_sphere(2e6), 0, 0, "sphere radius 2e+06 is outside"},
+        {carom_shape_box(1, 1, 1), 1, 1, ""},
+        {carom_shape_box(1, -1, 1), 0, 0, "box half extents (1, -1, 1)"},
+        {carom_shape_capsule(0.5, -1), 0, 0, "capsule half_height -1"},
+        {carom_shape_cylinder(0, 1), 0, 0, "cylinder radius 0"},
+        {carom_shape_hull(tetra, 4), 1, 1, ""},
+        {carom_shape_hull(tetra, 3), 0, 0, "a hull needs 4..100000 points (got 3)"},
+        {carom_shape_hull(far_tetra, 4), 0, 0, "hull point 3 has coordinate 2e+06"},
+        {carom_shape_plane(0, 0, 1, 0), 1, 0, "a plane can only be a static body"},
+        {carom_shape_plane(0, 0, 0, 0), 0, 0, "plane normal must be finite"},
+        {carom_shape_plane(0, 0, 1, 1e13), 0, 0, "plane offset 1e+13 is outside"},
+    };
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        for (int dynamic = 0; dynamic < 2; dynamic++) {
+            carom_body_type type = dynamic ? CAROM_BODY_DYNAMIC : CAROM_BODY_STATIC;
+            int want = dynamic ? cases[i].ok_dynamic : cases[i].ok_static;
+            char msg[256] = "untouched";
+            carom_status st = carom_shape_def_check(&cases[i].def, type, msg, sizeof msg);
+            assert_int_equal(st, want ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT);
+            if (want) assert_string_equal(msg, "");
+            else if (dynamic == cases[i].ok_static) assert_non_null(strstr(msg, cases[i].text)); /* the text: static's, or dynamic's where static is fine */
+            /* body_create applies the same rules */
+            carom_body_def bd = carom_body_def_default();
+            bd.type = type;
+            bd.shape = cases[i].def;
+            carom_body_id id = carom_body_create(w, &bd);
+            assert_int_equal(carom_body_is_valid(w, id), want);
+        }
+    }
+    char msg[64];
+    assert_int_equal(carom_shape_def_check(NULL, CAROM_BODY_STATIC, msg, sizeof msg), CAROM_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(msg, "shape is NULL"));
+    carom_shape_def s = carom_shape_sphere(1);
+    assert_int_equal(carom_shape_def_check(&s, (carom_body_type)7, msg, sizeof msg), CAROM_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(carom_shape_def_check(&s, CAROM_BODY_KINEMATIC, NULL, 0), CAROM_OK);
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1158,6 +1213,7 @@ int main(void)
         cmocka_unit_test(test_bounds_contain_and_touch),
         cmocka_unit_test(test_bounding_radius),
         cmocka_unit_test(test_ray_casts),
+        cmocka_unit_test(test_shape_def_check),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

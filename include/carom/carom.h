@@ -837,6 +837,14 @@ CAROM_API carom_status carom_body_set_material(carom_world *world, carom_body_id
 /* The body's material (a compound: the body-level values). out->size must be set. */
 CAROM_API carom_status carom_body_get_material(const carom_world *world, carom_body_id id, carom_material *out);
 
+/* Checks a shape def alone for a body of the given type, by the rules
+ * carom_body_create applies to it (lengths in range, a hull's point count
+ * and coordinates, a plane only static, a mesh or height field not
+ * dynamic; the data of a mesh, height field or compound come with the body
+ * def and are checked there). On error writes a readable message to msg
+ * (if not NULL) and returns CAROM_ERROR_INVALID_ARGUMENT. */
+CAROM_API carom_status carom_shape_def_check(const carom_shape_def *def, carom_body_type type, char *msg, size_t msg_size);
+
 #ifdef __cplusplus
 }
 #endif
