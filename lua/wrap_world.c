@@ -417,8 +417,9 @@ static void world_event_callback(void *context, const carom_contact_event *event
     lua_settop(L, top);
 }
 
-/* One step of the world at index 1; raises a callback's error after it. */
-static void step_once(lua_State *L, clua_world *lw, double dt)
+/* One step of the world at index 1; raises a callback's error after it.
+ * dt_arg: the argument dt came from (0: none), blamed when C refuses it. */
+static void step_once(lua_State *L, clua_world *lw, double dt, int dt_arg)
 {
     if (!lw->world) luaL_error(L, "step: the world has been destroyed (by a finalizer?)");
     lw->stepping = L;
@@ -438,7 +439,9 @@ static void step_once(lua_State *L, clua_world *lw, double dt)
     }
     if (st != CAROM_OK) {
         char buf[256];
-        luaL_error(L, "step: %s", clua_copy_error(lw->world, buf, sizeof buf));
+        const char *msg = clua_copy_error(lw->world, buf, sizeof buf);
+        if (st == CAROM_ERROR_INVALID_ARGUMENT && dt_arg > 0) clua_arg_error(L, dt_arg, "step", "%s", msg);
+        luaL_error(L, "step: %s", msg);
     }
 }
 
@@ -447,11 +450,10 @@ static int world_step(lua_State *L)
 {
     clua_world *lw = clua_check_world(L, 1, "step");
     if (lw->stepping) return luaL_error(L, "step: cannot step a world from inside its own contact callback");
-    double dt = clua_check_number(L, 2, "step");
-    if (!(dt > 0 && dt <= 1)) clua_arg_error(L, 2, "step", "dt must be in (0, 1] seconds");
+    double dt = clua_check_number(L, 2, "step"); /* its range: carom_world_step's */
     lua_Integer n = lua_isnoneornil(L, 3) ? 1 : clua_check_integer(L, 3, "step", 0, 100000000);
     lua_settop(L, 1);
-    for (lua_Integer i = 0; i < n; i++) step_once(L, lw, dt);
+    for (lua_Integer i = 0; i < n; i++) step_once(L, lw, dt, 2);
     return 0;
 }
 
@@ -472,7 +474,7 @@ static int world_advance(lua_State *L)
     while (lw->accumulator >= lw->fixed_dt && steps < lw->max_steps) {
         lw->accumulator -= lw->fixed_dt;
         steps++;
-        step_once(L, lw, lw->fixed_dt);
+        step_once(L, lw, lw->fixed_dt, 0);
     }
     if (lw->accumulator >= lw->fixed_dt) lw->accumulator = fmod(lw->accumulator, lw->fixed_dt);
     lua_pushinteger(L, steps);

@@ -439,7 +439,7 @@ test("argument errors name the function and the argument (self is #1)", function
   -- called from Lua code, the message is prefixed with the caller's position, as luaL_argerror does
   assert(not ok and tostring(m2):sub(-#m1) == m1 and tostring(m2):find("lua_api_test.lua:", 1, true), tostring(m2))
   raises("bad argument #1 to 'sphere' (sphere radius -1 is outside [1e-6, 1e6] m)", carom.sphere, { radius = -1 })
-  raises("bad argument #2 to 'step' (dt must be in (0, 1] seconds)", world.step, world, -1)
+  raises("bad argument #2 to 'step' (dt must be in [1e-6, 1] seconds (got -1))", world.step, world, -1)
   raises("bad argument #1 to 'step' (carom.World expected, got number)", world.step, 5, 1/60)
   local b = world:add_body{ shape = sphere() }
   raises("bad argument #1 to 'position' (carom.Body expected, got carom.World)", b.position, world)
