@@ -18,13 +18,10 @@
 #include "narrowphase.h"
 #include "compound.h"
 #include "gjk.h"
+#include "helpers.h"
 
 static uint64_t rng = 88172645463325252ull;
-static double urand(void)
-{
-    rng ^= rng << 13; rng ^= rng >> 7; rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return rnd(&rng); } /* helpers.h's xorshift64, the same sequence */
 static double srand1(void) { return 2 * urand() - 1; }
 
 enum { N_TYPES = 5 };
