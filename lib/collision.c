@@ -463,18 +463,22 @@ int world_collide(carom_world *w, const step_context *ctx)
     /* ascending, and a removal re-examines index i (the last contact, not yet
      * seen, moves there), so the indices already listed stay valid */
     int woken = 0;
+    /* contacts begin only where the bits allow them (add_pair): they can
+     * forbid one only after set_filter (or in a restored world) */
+    int check_filters = !w->filters_settled;
     for (int i = 0; i < cs->count;) {
         contact *c = &cs->items[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
         if (c->sub) {
             /* an extra manifold of a mesh pair: the pair's own contact (sub 0)
              * computes it; it goes when the pair does */
-            if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || !filter_bits_allow(s, a, b)) contact_remove(cs, i);
+            if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || (check_filters && !filter_bits_allow(s, a, b)))
+                contact_remove(cs, i);
             else i++;
             continue;
         }
         c->flags &= ~(uint32_t)CONTACT_SIM;
-        if (!filter_bits_allow(s, a, b)) { /* the bits changed since the pair was made */
+        if (check_filters && !filter_bits_allow(s, a, b)) { /* the bits changed since the pair was made */
             if (c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) events_touch(w, i, CAROM_EVENT_END);
             contact_remove(cs, i);
             continue;
@@ -488,6 +492,7 @@ int world_collide(carom_world *w, const step_context *ctx)
         }
         if (update_contact(w, ctx, i, a, b, reuse, 1, &woken)) i++;
     }
+    w->filters_settled = 1;
     /* Waking spreads through touching pairs whatever their order in the
      * cache: a body woken above takes part in all its pairs this step, so it
      * never passes through a sleeping neighbour. Repeats until no pair wakes

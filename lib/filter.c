@@ -25,6 +25,7 @@ CAROM_API carom_status carom_body_set_filter(carom_world *w, carom_body_id id, u
     s->category[slot] = category;
     s->filter_mask[slot] = mask;
     s->group[slot] = group;
+    w->filters_settled = 0; /* the next collision pass checks every contact's bits */
     /* contacts the new bits forbid end at the next step (with end events);
      * pairs they now allow are found then: the proxy counts as moved. The
      * body wakes so it responds to the new rule (a sleeper resting on what

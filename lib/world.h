@@ -75,6 +75,8 @@ struct carom_world {
     int in_callback;
     carom_pair_filter_fn *pair_filter; /* carom_world_set_pair_filter (filter.c) */
     void *pair_filter_context;
+    int filters_settled;        /* 1 once a collision pass has checked every contact's filter bits and no
+                                   body's bits changed since (set_filter clears it; 0 in a new world) */
     carom_pre_solve_fn *pre_solve;     /* carom_world_set_pre_solve (sensor.c) */
     void *pre_solve_context;
     sensor_overlap *sensor_overlaps; /* sorted by sensor, then other */
