@@ -24,7 +24,7 @@
 #include "compound.h"
 
 #define SNAP_MAGIC "CAROMSNP"
-#define SNAP_VERSION 3u
+#define SNAP_VERSION 4u
 #define SNAP_HEADER_SIZE 32u
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
@@ -1035,7 +1035,7 @@ static void point_guess(const reuse_motion *m, const contact_data *d, xform xa, 
 /* contact record bits, after the point count (3 bits) */
 enum { CREC_HAS_NORMAL = 8, CREC_FLIP = 16, CREC_SUB = 32, CREC_SUB_LIMIT = 64, CREC_FEATURE = 128, CREC_TANGENT = 256,
        CREC_NORMAL = 512, CREC_CACHE_NORMAL = 1024, CREC_MATERIAL = 2048, CREC_POSE = 4096, CREC_REACH = 8192,
-       CREC_NORMAL_A = 16384, CREC_ALL = 32767 };
+       CREC_NORMAL_A = 16384, CREC_EXACT = 32768, CREC_ALL = 65535 };
 
 /* The friction basis the solver starts from for a normal (solver.c): the
  * kept basis of a resting contact is usually this, to the last bits. */
@@ -1109,6 +1109,18 @@ static void write_contacts(writer *o, const carom_world *w)
         double reach = (c->flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[b]) : 0.0;
         vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
         unsigned bits = contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a);
+        /* every point where the reader predicts it (a settled pile's kept
+         * manifolds): their positions and separations are not written */
+        reuse_motion m = reuse_guess(c, g.xa, g.xb);
+        int exact = d->m.count > 0;
+        for (int k = 0; k < d->m.count && exact; k++) {
+            vec3 point;
+            double separation;
+            point_guess(&m, d, g.xa, &d->state[k], &point, &separation);
+            exact = same_bits(&point, &d->m.points[k].point, sizeof point) &&
+                    f64_bits(separation) == f64_bits(d->m.points[k].separation);
+        }
+        if (exact) bits |= CREC_EXACT;
         put_varint(o, zigzag((int64_t)c->id_a - last_a));
         put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
         last_a = c->id_a;
@@ -1137,7 +1149,6 @@ static void write_contacts(writer *o, const carom_world *w)
         /* each point against the one before it (a manifold's points share
          * their scale, most bits of their impulses, often all but a sign) */
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
-        reuse_motion m = reuse_guess(c, g.xa, g.xb);
         for (int k = 0; k < d->m.count; k++) {
             const manifold_point *p = &d->m.points[k];
             const contact_point_state *st = &d->state[k];
@@ -1149,8 +1160,10 @@ static void write_contacts(writer *o, const carom_world *w)
             put_varint(o, p->id);
             put_coded(o, cur, last, 3);
             put_coded(o, cur + 3, last + 3, 4);
-            put_coded_v3(o, p->point, point);
-            put_coded1(o, p->separation, separation);
+            if (!exact) {
+                put_coded_v3(o, p->point, point);
+                put_coded1(o, p->separation, separation);
+            }
             memcpy(last, cur, sizeof cur);
         }
     }
@@ -1621,7 +1634,8 @@ static int read_contacts(reader *r, carom_world *w)
             xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
             double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
             vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
-            if (contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) != (unsigned)bits)
+            if ((contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) | (bits & CREC_EXACT)) != (unsigned)bits ||
+                ((bits & CREC_EXACT) && d->m.count == 0))
                 return bad(r, "contact %d: its record bits do not match its fields", i);
         }
         if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
@@ -1629,6 +1643,7 @@ static int read_contacts(reader *r, carom_world *w)
             return bad(r, "contact %d material out of range", i);
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
         reuse_motion m = reuse_guess(c, g.xa, g.xb);
+        int inexact = 0;
         for (int k = 0; k < d->m.count && !r->failed; k++) {
             manifold_point *p = &d->m.points[k];
             contact_point_state *st = &d->state[k];
@@ -1644,8 +1659,11 @@ static int read_contacts(reader *r, carom_world *w)
             vec3 point;
             double separation;
             point_guess(&m, d, g.xa, st, &point, &separation);
-            p->point = get_coded_v3(r, point, "manifold point");
-            p->separation = get_coded1(r, separation, "manifold point");
+            p->point = (bits & CREC_EXACT) ? point : get_coded_v3(r, point, "manifold point");
+            p->separation = (bits & CREC_EXACT) ? separation : get_coded1(r, separation, "manifold point");
+            if (!same_bits(&point, &p->point, sizeof point) || f64_bits(separation) != f64_bits(p->separation)) inexact = 1;
+            if (!(isfinite(p->point.x) && isfinite(p->point.y) && isfinite(p->point.z) && isfinite(p->separation)))
+                return bad(r, "contact %d: a point or separation is not finite", i);
             memcpy(last, cur, sizeof cur);
             /* warm-start impulses the solver could have stored (a fuzzed one of
              * 1.7e307 N s threw a hull 1.9e303 m in one step) */
@@ -1654,6 +1672,9 @@ static int read_contacts(reader *r, carom_world *w)
                                 fabs(st->tangent_impulse[1]) <= RANGE_FRICTION_MAX * RANGE_IMPULSE_MAX))
                 return bad(r, "contact %d: a warm-start impulse outside [0, 1e30] N s (tangent 1e33)", i);
         }
+        /* one encoding per state: points all as predicted say so in the bits */
+        if (!r->failed && d->m.count > 0 && !(bits & CREC_EXACT) && !inexact)
+            return bad(r, "contact %d: its points are all as predicted but written", i);
     }
     return !r->failed;
 }

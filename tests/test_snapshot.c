@@ -283,12 +283,12 @@ static void test_bad_snapshots_refused(void **state)
     /* wrong version, foreign data */
     unsigned char *copy = malloc(s.size);
     memcpy(copy, s.data, s.size);
-    copy[8] = 2; /* the format before this one */
+    copy[8] = 3; /* the format before this one */
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
-    assert_non_null(strstr(msg, "version 2"));
-    copy[8] = 4;
+    assert_non_null(strstr(msg, "version 3"));
+    copy[8] = 5;
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
-    assert_non_null(strstr(msg, "version 4"));
+    assert_non_null(strstr(msg, "version 5"));
     memcpy(copy, "PNG\r\n\x1a\n\0", 8);
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
     assert_non_null(strstr(msg, "not a carom snapshot"));
