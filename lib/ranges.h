@@ -33,6 +33,10 @@
  * needle) that rounding is 6e-7 of 1/I_max (2.8e-5 at a whole ulp). */
 #define RANGE_ANISOTROPY_MAX 1e12
 #define RANGE_SPEED_MAX 1e9         /* m/s and rad/s: ceiling of max_linear/angular_speed */
+/* m/s and rad/s: floor of max_linear/angular_speed (an explicit one): the
+ * smallest length over the longest step, 1e-6 m / 1 s; a slower cap holds
+ * every body below what the lengths resolve */
+#define RANGE_SPEED_MIN 1e-6
 #define RANGE_ACCELERATION_MAX 1e9  /* m/s^2: |gravity| x |gravity_scale|, |force| / mass */
 #define RANGE_GRAVITY_MAX 1e4       /* m/s^2: |world gravity| */
 #define RANGE_GRAVITY_SCALE_MAX 1e4 /* |gravity_scale| */

@@ -101,9 +101,13 @@ static int def_validate(const carom_world_def *d, char *msg, size_t n)
             "sleep_linear_velocity must be in [0, 1e9] m/s (got %g)", d->sleep_linear_velocity);
     REQUIRE(d->sleep_angular_velocity >= 0 && d->sleep_angular_velocity <= RANGE_SPEED_MAX,
             "sleep_angular_velocity must be in [0, 1e9] rad/s (got %g)", d->sleep_angular_velocity);
-    REQUIRE(d->max_linear_speed > 0 && d->max_linear_speed <= 1e9, "max_linear_speed must be in (0, 1e9]");
-    REQUIRE(d->max_angular_speed >= 0 && d->max_angular_speed <= 1e9,
-            "max_angular_speed must be 0 (automatic) or in (0, 1e9]");
+    /* the clamps divide by the largest component above half the cap: a cap of
+     * a few subnormals (fuzz: 1.9e-322) overflowed it and made NaN */
+    REQUIRE(d->max_linear_speed >= RANGE_SPEED_MIN && d->max_linear_speed <= RANGE_SPEED_MAX,
+            "max_linear_speed must be in [1e-6, 1e9] (got %g)", d->max_linear_speed);
+    REQUIRE(d->max_angular_speed == 0 ||
+                (d->max_angular_speed >= RANGE_SPEED_MIN && d->max_angular_speed <= RANGE_SPEED_MAX),
+            "max_angular_speed must be 0 (automatic) or in [1e-6, 1e9] (got %g)", d->max_angular_speed);
     REQUIRE(isfinite(d->contact_reuse_distance) && d->contact_reuse_distance >= 0 && d->contact_reuse_distance <= 0.01,
             "contact_reuse_distance must be in [0, 0.01] m");
     REQUIRE(d->body_capacity >= 0 && d->body_capacity <= (1 << 26), "body_capacity must be in 0..2^26");

@@ -199,6 +199,7 @@ static int b_spin(carom_body_def *d, double v) { d->angular_velocity = vec(v, 0,
 static int w_gravity(carom_world_def *d, double v) { d->gravity = vec(0, 0, -v); return 1; }
 static int w_hertz(carom_world_def *d, double v) { d->contact_hertz = v; return 1; }
 static int w_max_speed(carom_world_def *d, double v) { d->max_linear_speed = v; return 1; }
+static int w_max_spin(carom_world_def *d, double v) { d->max_angular_speed = v; return 1; }
 static carom_status s_set_mass(carom_world *w, carom_body_id id, double v) { return carom_body_set_mass(w, id, v); }
 static carom_status s_speed(carom_world *w, carom_body_id id, double v)
 {
@@ -236,7 +237,10 @@ static const edge edges[] = {
     {"gravity", 1e4, +1, "at most 1e4 m/s^2", w_gravity, NULL, NULL, 1.0 / 60},
     {"contact_hertz, low", 1e-3, -1, "[1e-3, 1e6]", w_hertz, NULL, NULL, 1.0 / 60},
     {"contact_hertz, high", 1e6, +1, "[1e-3, 1e6]", w_hertz, NULL, NULL, 1.0 / 60},
-    {"max_linear_speed", 1e9, +1, "(0, 1e9]", w_max_speed, NULL, NULL, 1.0 / 60},
+    {"max_linear_speed", 1e9, +1, "[1e-6, 1e9]", w_max_speed, NULL, NULL, 1.0 / 60},
+    {"max_linear_speed, low", 1e-6, -1, "[1e-6, 1e9]", w_max_speed, NULL, NULL, 1.0 / 60},
+    {"max_angular_speed, low", 1e-6, -1, "[1e-6, 1e9]", w_max_spin, NULL, NULL, 1.0 / 60},
+    {"max_angular_speed, high", 1e9, +1, "[1e-6, 1e9]", w_max_spin, NULL, NULL, 1.0 / 60},
     {"time step, low", 1e-6, -1, "[1e-6, 1] seconds", NULL, NULL, NULL, 0},
     {"time step, high", 1.0, +1, "[1e-6, 1] seconds", NULL, NULL, NULL, 0},
 };
