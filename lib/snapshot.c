@@ -95,6 +95,11 @@ typedef struct reader {
     int failed;
 } reader;
 
+/* The reader's pose checks: a quaternion more than 1e-6 from unit length, and
+ * a vector inside the cube |x|, |y|, |z| <= limit (NaN fails it). */
+static int not_unit(quat q) { return fabs(q_len(q) - 1.0) > 1e-6; }
+static int within_cube(vec3 v, double limit) { return fabs(v.x) <= limit && fabs(v.y) <= limit && fabs(v.z) <= limit; }
+
 static int bad(reader *r, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -635,7 +640,7 @@ static tri_mesh *read_mesh(reader *r)
     for (int i = 0; i < nv && !r->failed; i++) {
         m->vertices[i] = get_v3(r, "mesh vertex");
         vec3 v = m->vertices[i];
-        if (!r->failed && !(fabs(v.x) <= RANGE_LENGTH_MAX && fabs(v.y) <= RANGE_LENGTH_MAX && fabs(v.z) <= RANGE_LENGTH_MAX))
+        if (!r->failed && !within_cube(v, RANGE_LENGTH_MAX))
             bad(r, "mesh vertex %d is beyond 1e6 m", i);
     }
     for (int t = 0; t < nt && !r->failed; t++) {
@@ -722,8 +727,8 @@ static compound *read_compound(reader *r)
         if (r->failed) break;
         vec3 p = c->poses[i].p;
         quat q = c->poses[i].q;
-        if (!(fabs(p.x) <= RANGE_LENGTH_MAX && fabs(p.y) <= RANGE_LENGTH_MAX && fabs(p.z) <= RANGE_LENGTH_MAX) ||
-            fabs(sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) > 1e-6) {
+        if (!within_cube(p, RANGE_LENGTH_MAX) ||
+            not_unit(q)) {
             bad(r, "compound child %d pose out of range", i);
             break;
         }
@@ -1471,7 +1476,7 @@ static int read_bodies(reader *r, carom_world *w)
         if (!(fabs(s->center[i].x) <= RANGE_COORDINATE_MAX && fabs(s->center[i].y) <= RANGE_COORDINATE_MAX &&
               fabs(s->center[i].z) <= RANGE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e12 m", i); break; }
         quat q = s->rotation[i];
-        if (fabs(sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) > 1e-6) { bad(r, "body %d orientation is not unit", i); break; }
+        if (not_unit(q)) { bad(r, "body %d orientation is not unit", i); break; }
         if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX)) {
             bad(r, "body %d moves faster than any world allows", i);
             break;
@@ -1497,7 +1502,7 @@ static int read_bodies(reader *r, carom_world *w)
         if (!(fabs(s->previous_origin[i].x) <= RANGE_COORDINATE_MAX && fabs(s->previous_origin[i].y) <= RANGE_COORDINATE_MAX &&
               fabs(s->previous_origin[i].z) <= RANGE_COORDINATE_MAX)) { bad(r, "body %d previous pose is beyond 1e12 m", i); break; }
         quat pq = s->previous_rotation[i];
-        if (fabs(sqrt(pq.w * pq.w + pq.x * pq.x + pq.y * pq.y + pq.z * pq.z) - 1.0) > 1e-6) {
+        if (not_unit(pq)) {
             bad(r, "body %d previous orientation is not unit", i);
             break;
         }
@@ -1507,8 +1512,8 @@ static int read_bodies(reader *r, carom_world *w)
         if (r->failed) break;
         vec3 co = s->collided[i].p;
         quat cq = s->collided[i].q;
-        if (!(fabs(co.x) <= RANGE_COORDINATE_MAX && fabs(co.y) <= RANGE_COORDINATE_MAX && fabs(co.z) <= RANGE_COORDINATE_MAX) ||
-            fabs(sqrt(cq.w * cq.w + cq.x * cq.x + cq.y * cq.y + cq.z * cq.z) - 1.0) > 1e-6) {
+        if (!within_cube(co, RANGE_COORDINATE_MAX) ||
+            not_unit(cq)) {
             bad(r, "body %d collided pose is beyond 1e12 m or not unit", i);
             break;
         }
