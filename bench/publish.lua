@@ -122,6 +122,182 @@ local function peers_table(path)
   return out
 end
 
+-- read a published result file's lines (nil when this run did not make it)
+local function lines_of(name)
+  local f = io.open(out .. "/" .. name, "rb")
+  if not f then return nil end
+  local t = {}
+  for line in f:lines() do t[#t + 1] = line end
+  f:close()
+  return t
+end
+local function mm(x) return string.format(x < 0.01 and "%.2f" or "%.1f", 1000 * x) end
+local function cm_or_mm(x) return x >= 0.1 and string.format("%.0f cm", 100 * x) or (mm(x) .. " mm") end
+
+-- the envelope table, from bench/extremes.c's lines
+local function envelope_table()
+  local t = lines_of("extremes.txt")
+  if not t then return nil end
+  local r = {}
+  for _, line in ipairs(t) do
+    local preset, case, holds, err = line:match("^preset=(%S+) case=(%S+) holds=(%S+) error=(%S+)")
+    if preset then r[preset .. "/" .. case] = { holds = holds == "yes", err = tonumber(err) } end
+  end
+  local presets = { "fast", "default", "accurate" }
+  local function row(label, cases, fmt)
+    local cells = { "| " .. label .. " |" }
+    for _, p in ipairs(presets) do
+      local parts = {}
+      for _, c in ipairs(cases) do
+        local v = r[p .. "/" .. c]
+        parts[#parts + 1] = v and fmt(v) or "-"
+      end
+      cells[#cells + 1] = " " .. table.concat(parts, " / ") .. " |"
+    end
+    return table.concat(cells)
+  end
+  local function held(v, text) return (v.holds and "yes" or "**no**") .. (text and (" (" .. text .. ")") or "") end
+  return {
+    "| case | fast | default | accurate |",
+    "|---|---|---|---|",
+    row("heavy box on 1 kg box, 1e3 / 1e6 / 1e9 : 1 (height error)", { "mass_ratio_1000", "mass_ratio_1e+06", "mass_ratio_1e+09" },
+        function(v) return held(v, mm(v.err) .. " mm") end),
+    row("1 cm sphere at 100 / 1000 / 3000 m/s into a 5 cm wall (face at x = 1 m)", { "speed_100m/s", "speed_1000m/s", "speed_3000m/s" },
+        function(v) return held(v, string.format("x %.4g", v.err)) end),
+    row("box at rest, 1 mm / 1 cm / 100 m / 1 km (10 s; within 1 % of size or 6 mm)", { "size_0.001m", "size_0.01m", "size_100m", "size_1000m" },
+        function(v) return held(v, string.format("%.3g mm", 1000 * v.err)) end),
+    row("5-box stack at 1e5 m and 1e7 m from the origin (top, < 3 cm)", { "stack_at_1e5m", "stack_at_1e7m" },
+        function(v) return held(v, mm(v.err) .. " mm") end),
+    row("5-box stack at dt 1/1000, 1/120, 1/30, 1/15 s (top, < 10 cm)", { "dt_1/1000", "dt_1/120", "dt_1/30", "dt_1/15" },
+        function(v) return held(v, cm_or_mm(v.err)) end),
+    row("1,000,000-step soak (e = 0.9 room)", { "soak_1000000_steps" }, function(v) return held(v) end),
+  }
+end
+
+-- least-squares slope of log(y) against log(x)
+local function loglog_slope(xs, ys)
+  local n, sx, sy, sxx, sxy = #xs, 0, 0, 0, 0
+  for i = 1, n do
+    local x, y = math.log(xs[i]), math.log(ys[i])
+    sx, sy, sxx, sxy = sx + x, sy + y, sxx + x * x, sxy + x * y
+  end
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx)
+end
+local function csv(name)
+  local t = lines_of(name)
+  if not t then return nil end
+  local header, rows = {}, {}
+  for k in (t[1] .. ","):gmatch("([^,]*),") do header[#header + 1] = k end
+  for i = 2, #t do
+    local r, j = {}, 1
+    for v in (t[i] .. ","):gmatch("([^,]*),") do r[header[j]] = tonumber(v) or v; j = j + 1 end
+    rows[#rows + 1] = r
+  end
+  return rows
+end
+local function thousands(n)
+  local s = string.format("%d", n)
+  repeat local k; s, k = s:gsub("^(%d+)(%d%d%d)", "%1,%2") until k == 0
+  return s
+end
+
+-- the scaling and detection figures, from scaling.csv, pyramids.csv,
+-- broadphase.txt and narrowphase.txt
+local function scaling_figures()
+  local body = {}
+  local pile = csv("scaling.csv")
+  if pile and #pile >= 2 then
+    local xs, ys = {}, {}
+    for _, r in ipairs(pile) do xs[#xs + 1] = r.bodies; ys[#ys + 1] = r.ms_step end
+    local a, b = pile[1], pile[#pile]
+    body[#body + 1] = string.format("- **Pile, one thread:** time per step grows as bodies^%.2f (least squares over %d sizes) from %s to %s bodies: %.2f ms to %.0f ms, %.2f to %.2f us per body-step.",
+      loglog_slope(xs, ys), #pile, thousands(a.bodies), thousands(b.bodies), a.ms_step, b.ms_step,
+      1000 * a.ms_step / a.bodies, 1000 * b.ms_step / b.bodies)
+  end
+  local grid = csv("pyramids.csv")
+  if grid then
+    local function pick(engine, preset, workers)
+      local t = {}
+      for _, r in ipairs(grid) do
+        if r.engine == engine and r.preset == preset and r.workers == workers then t[#t + 1] = r end
+      end
+      table.sort(t, function(x, y) return x.bodies < y.bodies end)
+      return t
+    end
+    local c, one = pick("carom", "default", 1), nil
+    if #c >= 2 then
+      local a, b = c[1], c[#c]
+      one = b
+      local xs, ys = {}, {}
+      for _, r in ipairs(c) do xs[#xs + 1] = r.bodies; ys[#ys + 1] = r.ms_step end
+      local first = 0
+      for _, r in ipairs(c) do
+        local settled = r.ms_step
+        first = math.max(first, tonumber(r.first_step_ms) and r.first_step_ms / settled or 0,
+                         tonumber(r.first_step_clamp_ms) and r.first_step_clamp_ms / settled or 0)
+      end
+      body[#body + 1] = string.format("- **Pyramid grid, default preset, one thread:** %.2f us per body-step at %s bodies, %.2f at %s (x%.2f; slope %.2f); peak memory %.1f KB per body at %s; the first step after adding every body (with or without one at the speed clamp) costs up to %.2fx a settled step.",
+        a.us_body_step, thousands(a.bodies), b.us_body_step, thousands(b.bodies), b.us_body_step / a.us_body_step,
+        loglog_slope(xs, ys), b.kb_per_body, thousands(b.bodies), first)
+    end
+    local two = pick("carom", "default", 2)
+    if one and #two > 0 and two[#two].bodies == one.bodies then
+      body[#body + 1] = string.format("- **Threads:** at %s bodies the reference pool's 2 workers take x%.2f of one worker's time.",
+        thousands(one.bodies), two[#two].ms_step / one.ms_step)
+    end
+    for _, peer in ipairs{ { "box3d", "Box3D" }, { "jolt", "Jolt" } } do
+      local p = pick(peer[1], "default", 1)
+      if one and #p > 0 and p[#p].bodies == one.bodies then
+        body[#body + 1] = string.format("- **Beside %s in the same run:** at %s bodies carom takes %.0f ms per step, %s %.0f ms (x%.2f); %.1f against %.1f KB per body.",
+          peer[2], thousands(one.bodies), one.ms_step, peer[2], p[#p].ms_step, one.ms_step / p[#p].ms_step, one.kb_per_body, p[#p].kb_per_body)
+      end
+    end
+  end
+  local bp = lines_of("broadphase.txt")
+  if bp then
+    local tree, brute = {}, {}
+    for _, line in ipairs(bp) do
+      local kind, n = line:match("^bench=(%S+) bodies=(%d+)")
+      if kind == "broadphase" then
+        tree[#tree + 1] = { n = tonumber(n), update = tonumber(line:match("ms_update=(%S+)")),
+                            move = tonumber(line:match("ms_move=(%S+)")), height = line:match("height=(%d+)") }
+      elseif kind == "brute_force" then brute[#brute + 1] = { n = tonumber(n), update = tonumber(line:match("ms_update=(%S+)")) } end
+    end
+    local u, m, h, bn, bu = {}, {}, {}, {}, {}
+    for _, r in ipairs(tree) do u[#u + 1] = string.format("%.2g", r.update); m[#m + 1] = string.format("%.2g", r.move); h[#h + 1] = r.height end
+    for _, r in ipairs(brute) do bn[#bn + 1] = thousands(r.n); bu[#bu + 1] = string.format("%.3g", r.update) end
+    local ns = {}
+    for _, r in ipairs(tree) do ns[#ns + 1] = thousands(r.n) end
+    if #tree > 0 then
+      body[#body + 1] = "- **Broadphase pair finding** (`bench/bench_broadphase.c`, ~1 m boxes, about 14 % re-inserted per step) at " ..
+        table.concat(ns, " / ") .. " bodies: `update_pairs` " .. table.concat(u, " / ") .. " ms per step plus " ..
+        table.concat(m, " / ") .. " ms of re-insertion; tree height " .. table.concat(h, " / ") ..
+        (#brute > 0 and ("; brute force " .. table.concat(bu, " / ") .. " ms at " .. table.concat(bn, " / ") .. " bodies") or "") .. "."
+    end
+  end
+  local np = lines_of("narrowphase.txt")
+  if np and #np > 0 then
+    local parts = {}
+    for _, line in ipairs(np) do
+      local pair, ns = line:match("pair=(%S+) ns_per_pair=(%S+)")
+      if pair then parts[#parts + 1] = pair .. " " .. thousands(tonumber(ns)) end
+    end
+    body[#body + 1] = "- **Narrowphase, ns per pair near contact** (`bench/bench_narrowphase.c`, fresh manifolds, no kept ones): " ..
+      table.concat(parts, ", ") .. "."
+  end
+  return #body > 0 and body or nil
+end
+
+-- terrain and snapshot lines, quoted from their own benches
+local function quoted(name)
+  local t = lines_of(name)
+  if not t or #t == 0 then return nil end
+  local body = { "```" }
+  for _, line in ipairs(t) do body[#body + 1] = line end
+  body[#body + 1] = "```"
+  return body
+end
+
 local function replace_between(text, begin_mark, end_mark, body)
   local a, b = text:find(begin_mark, 1, true)
   local c = text:find(end_mark, 1, true)
@@ -130,8 +306,19 @@ local function replace_between(text, begin_mark, end_mark, body)
 end
 local f = assert(io.open(readme, "rb"))
 local text = f:read("a"); f:close()
-text = replace_between(text, "<!-- presets table: written by make bench (bench/publish.lua) -->",
-                       "<!-- end of presets table -->", lines)
+if #rows > 0 then
+  text = replace_between(text, "<!-- presets table: written by make bench (bench/publish.lua) -->",
+                         "<!-- end of presets table -->", lines)
+else
+  io.stderr:write("publish: " .. out .. "/sweep.csv has no rows: the presets table is left as it was\n")
+end
+for _, block in ipairs{ { "envelope table", envelope_table() }, { "scaling figures", scaling_figures() },
+                        { "terrain figures", quoted("terrain.txt") }, { "snapshot figures", quoted("snapshot.txt") } } do
+  if block[2] then
+    text = replace_between(text, "<!-- " .. block[1] .. ": written by make bench (bench/publish.lua) -->",
+                           "<!-- end of " .. block[1] .. " -->", block[2])
+  end
+end
 local peers = peers_table(out .. "/peers.txt")
 if peers then
   text = replace_between(text, "<!-- peers table: written by make bench (bench/publish.lua) -->",

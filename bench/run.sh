@@ -15,6 +15,15 @@ RUNS=${RUNS:-3}
 start=$(date +%s)
 elapsed() { s=$(($(date +%s) - start)); printf '%d:%02d' $((s / 60)) $((s % 60)); }
 phase() { echo; echo "== [$(elapsed)] $*"; }
+# logged OUT CMD...: runs CMD, shows its output as it comes and keeps it in
+# OUT; a CMD that fails (a crash included) stops the bench, since a plain
+# pipe into tee would hide its status and publish an empty or partial file.
+logged() {
+    log=$1; shift
+    { status=0; "$@" || status=$?; echo "$status" > "$log.rc"; } | tee "$log"
+    rc=$(cat "$log.rc" 2>/dev/null || echo unknown); rm -f "$log.rc"
+    [ "$rc" = 0 ] || { echo "bench: '$*' failed (exit $rc); $log is incomplete" >&2; exit 1; }
+}
 
 # the peers and the plotter are Debian packages (installed as root, like make deps)
 need=""
@@ -44,21 +53,21 @@ for peer in box3d:${BOX3D_BENCH:-} jolt:${JOLT_BENCH:-}; do
     if [ -n "$bin" ] && [ -x "$bin" ]; then ln -s "$bin" "peers/build/bench_$name"; fi
 done
 if [ "$quick" = 1 ]; then
-    RUNS=1 ./peers/run.sh | tee out/peers_quick.txt
+    logged out/peers_quick.txt env RUNS=1 ./peers/run.sh
     echo "bench-quick: bench/out/peers_quick.txt in $(elapsed) (one round; make bench for 3 rounds and the rest)"
     exit 0
 fi
-RUNS=$RUNS ./peers/run.sh | tee out/peers.txt
+logged out/peers.txt env RUNS="$RUNS" ./peers/run.sh
 cp peers/build/raw.txt out/peers_raw.txt
 
 phase "broadphase pair finding"
-../build/bench/bench_broadphase | tee out/broadphase.txt
+logged out/broadphase.txt ../build/bench/bench_broadphase
 
 phase "speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
 # progress: one line per scene as its first row arrives. The error columns
 # are deterministic: one run each; ms/step is the median of RUNS only for the
 # pyramid, whose front the README shows (the pile, heavy, is timed once).
-../build/bench/sweep --runs "$RUNS" --timed pyramid | tee out/sweep.csv | {
+{ status=0; ../build/bench/sweep --runs "$RUNS" --timed pyramid || status=$?; echo "$status" > out/sweep.rc; } | tee out/sweep.csv | {
     read -r _header; scene=""; rows=0
     while IFS=, read -r name _rest; do
         rows=$((rows + 1))
@@ -66,14 +75,16 @@ phase "speed/accuracy sweep (every scene, every knob; CSV and Pareto plots)"
     done
     echo "sweep: $rows rows" >&2
 }
+rc=$(cat out/sweep.rc); rm -f out/sweep.rc
+[ "$rc" = 0 ] || { echo "bench: the sweep failed (exit $rc); out/sweep.csv is incomplete" >&2; exit 1; }
 if command -v gnuplot >/dev/null 2>&1; then
-    lua5.4 plot.lua out/sweep.csv out | tee out/pareto.txt
+    logged out/pareto.txt lua5.4 plot.lua out/sweep.csv out
 else
     echo "bench: no gnuplot: plots skipped (apt-get install gnuplot-nox)"
 fi
 
 phase "scaling: pile of 100 to 50,000 bodies"
-../build/bench/scaling | tee out/scaling.csv
+logged out/scaling.csv ../build/bench/scaling
 if command -v gnuplot >/dev/null 2>&1; then lua5.4 plot_scaling.lua out/scaling.csv out/scaling; fi
 
 phase "scaling: pyramid grid, 990 to 49,995 bodies, every preset, threads, first step, memory (beside Box3D/Jolt if BOX3D_BENCH/JOLT_BENCH)"
@@ -81,16 +92,16 @@ phase "scaling: pyramid grid, 990 to 49,995 bodies, every preset, threads, first
 if command -v gnuplot >/dev/null 2>&1; then lua5.4 plot_scaling.lua out/pyramids.csv out/pyramids; fi
 
 phase "narrowphase cost per pair type"
-../build/bench/bench_narrowphase | tee out/narrowphase.txt
+logged out/narrowphase.txt ../build/bench/bench_narrowphase
 
 phase "the envelope at each preset (mass ratio, speed, size, distance, time step, 1e6-step soak)"
-../build/bench/extremes 1000000 | tee out/extremes.txt
+logged out/extremes.txt ../build/bench/extremes 1000000
 
 phase "level geometry: 1,000 mixed bodies on a 100,352-triangle mesh and a 316 x 316 height field"
-../build/bench/terrain | tee out/terrain.txt
+logged out/terrain.txt ../build/bench/terrain
 
 phase "snapshots: a settled pile of 10,000 bodies"
-../build/bench/snapshot | tee out/snapshot.txt
+logged out/snapshot.txt ../build/bench/snapshot
 
 phase "publish: docs/bench/ and the README's presets table from this run"
 lua5.4 publish.lua out ../docs/bench ../README.md
