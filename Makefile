@@ -262,6 +262,6 @@ deps:
 	fi
 
 clean:
-	rm -rf build build-san bench/out bench/peers/build lib/libcarom.so* lib/libcarom.a
+	rm -rf build build-san bench/out bench/peers/build lib/libcarom.so* lib/libcarom.a  # all but build: left by older checkouts
 
 FORCE:

@@ -1,14 +1,14 @@
 -- publish.lua - the last phase of make bench: copies the results the README
--- shows from bench/out/ to docs/bench/ and rewrites the README's presets
+-- shows from build/bench/out/ to docs/bench/ and rewrites the README's presets
 -- table (between its "presets table" markers) from the same run's sweep.csv,
 -- so one `make bench` refreshes every figure the README points at.
--- Usage: lua5.4 bench/publish.lua bench/out docs/bench README.md
+-- Usage: lua5.4 bench/publish.lua build/bench/out docs/bench README.md
 local here = arg[0]:match("^(.*)/[^/]*$") or "."
 package.path = here .. "/?.lua;" .. package.path
 local sweep = require "sweep_rows"
 
 local out, docs, readme = arg[1], arg[2], arg[3]
-assert(out and docs and readme, "usage: lua5.4 publish.lua bench/out docs/bench README.md")
+assert(out and docs and readme, "usage: lua5.4 publish.lua build/bench/out docs/bench README.md")
 
 local function copy(name)
   local src = io.open(out .. "/" .. name, "rb")

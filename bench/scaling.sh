@@ -17,7 +17,7 @@
 # CPU ms/step beside all on (OUT minus .csv plus _switches.csv).
 set -eu
 cd "$(dirname "$0")"
-out=${1:-out/pyramids.csv}
+out=${1:-../build/bench/out/pyramids.csv}
 SIZES=${SIZES:-990 5005 20020 49995}
 TIMED=${TIMED:-60}
 bin=../build/bench/scaling

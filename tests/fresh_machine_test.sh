@@ -86,10 +86,19 @@ for case in "no-pkg-config no" "pkg-config-without-pc yes"; do
     if PATH="$tmp/$1/bin:$tmp/system-bin" PKG_CONFIG_LIBDIR="$tmp/$1/pc" sh -c 'pkg-config --exists ccd' 2>/dev/null; then
         fail "$1: ccd.pc is visible before deps"
     fi
+    (cd "$tmp/$1/src" && find . | sort) > "$tmp/$1/files.copy"
     run_demo "$1" || { tail -20 "$tmp/$1/out"; fail "$1: make demo failed the first time"; }
+    # every output under build/, and make clean takes away all it made
+    (cd "$tmp/$1/src" && find . -path ./build -prune -o -print | sort) > "$tmp/$1/files.built"
+    diff "$tmp/$1/files.copy" "$tmp/$1/files.built" || fail "$1: make demo wrote outside build/"
+    (cd "$tmp/$1/src" && env -u MAKEFLAGS -u MAKELEVEL -u MFLAGS PATH="$tmp/$1/bin:$tmp/system-bin" make -s clean) \
+        || fail "$1: make clean failed"
+    (cd "$tmp/$1/src" && find . | sort) > "$tmp/$1/files.cleaned"
+    diff "$tmp/$1/files.copy" "$tmp/$1/files.cleaned" || fail "$1: make clean left files behind"
     grep -q "apt-get install" "$tmp/$1/apt.log" || fail "$1: deps did not call apt-get install"
     grep -q "showcase: every check above holds" "$tmp/$1/out" || { tail -20 "$tmp/$1/out"; fail "$1: the showcase did not run"; }
-    echo "fresh_machine_test: $1: make demo installed the packages, built and ran the showcase the first time"
+    echo "fresh_machine_test: $1: make demo installed the packages, built and ran the showcase the first time;" \
+         "it wrote only under build/, and make clean removed all of it"
 done
 
 machine not-root 1000 no
