@@ -1,5 +1,5 @@
 /* extremes.c - the stability envelope at each preset (full versions of
- * tests/test_extremes.c): mass ratios, speeds, sizes, distance from the
+ * tests/test_ranges.c): mass ratios, speeds, sizes, distance from the
  * origin, time steps and a one-million-step soak. One line per case and
  * preset: holds yes/no and the measured error. */
 #define _POSIX_C_SOURCE 200809L

@@ -1,4 +1,4 @@
-/* test_triangle_pairs.c - every convex shape (sphere, capsule, box,
+/* test_triangle_contact.c - every convex shape (sphere, capsule, box,
  * cylinder, hull) against one triangle, checked against an independent
  * brute-force computation: apart, touching and deep, over the face, beyond
  * an edge and beyond a vertex, and the same poses with the edges internal.

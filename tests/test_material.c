@@ -1,4 +1,4 @@
-/* test_materials.c - named materials: every combine mode against its
+/* test_material.c - named materials: every combine mode against its
  * formula (read from the contact the pair makes), the mode priority,
  * friction and restitution through the motion they cause (a box sliding
  * slows at mu g, a ball bounces back at e v), rolling resistance against

@@ -1,4 +1,4 @@
-/* test_threads.c - the task hooks: any worker count and any scheduling give
+/* test_tasks.c - the task hooks: any worker count and any scheduling give
  * bitwise the same world (the snapshot, which holds every body's state,
  * every contact's manifold and impulses, compared byte for byte); the
  * hooks' validation; a hook that breaks the contract stops a debug build. */

@@ -1,4 +1,4 @@
-/* test_impacts.c - impacts at the moment of contact, against the seed's
+/* test_impact.c - impacts at the moment of contact, against the seed's
  * rigid-body impulse formulas and the conservation laws: an oblique ball on a
  * plane (sliding and sticking friction), an off-centre pair of spheres, a
  * 60 m/s reflection that keeps the rest of its step, a touching Newton's
