@@ -94,54 +94,11 @@ static int check_mass_props(const carom_world *w, const mass_props *mp, const ch
 /* |v| within the world's clamp (max_linear_speed / max_angular_speed). */
 static int speed_ok(carom_vec3 v, double max) { return finite_c(v) && len_c(v) <= max; }
 
-#define COMPOUND_MAX_CHILDREN 256
-
-/* Child i of a compound def (the array's stride is its first element's size). */
-static carom_compound_child child_def(const carom_body_def *d, int i)
-{
-    carom_compound_child c = carom_compound_child_default(carom_shape_sphere(0.5));
-    size_t stride = d->children[0].size;
-    const carom_compound_child *src = (const carom_compound_child *)(const void *)((const char *)d->children + stride * (size_t)i);
-    memcpy(&c, src, stride < sizeof c ? stride : sizeof c);
-    return c;
-}
-
 static int check_children(carom_world *w, const carom_body_def *d)
 {
-#define CFAIL(...) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, __VA_ARGS__), 0
-    if (!d->children || d->child_count < 1)
-        CFAIL("body_create: a compound needs children (got %d%s)", d->child_count, d->children ? "" : ", NULL array");
-    if (d->child_count > COMPOUND_MAX_CHILDREN)
-        CFAIL("body_create: a compound takes at most %d children (got %d)", COMPOUND_MAX_CHILDREN, d->child_count);
-    if (d->children[0].size < offsetof(carom_compound_child, density) + sizeof(double))
-        CFAIL("body_create: children[0].size %u too small: use carom_compound_child_default()", (unsigned)d->children[0].size);
-    for (int i = 0; i < d->child_count; i++) {
-        carom_compound_child c = child_def(d, i);
-        carom_shape_type t = c.shape.type;
-        if (t != CAROM_SHAPE_SPHERE && t != CAROM_SHAPE_BOX && t != CAROM_SHAPE_CAPSULE && t != CAROM_SHAPE_CYLINDER &&
-            t != CAROM_SHAPE_HULL)
-            CFAIL("body_create: children[%d].shape must be convex (sphere, box, capsule, cylinder or hull), got type %d", i, (int)t);
-        if (!check_shape(w, &c.shape, CAROM_BODY_DYNAMIC)) {
-            char msg[WORLD_ERROR_SIZE];
-            snprintf(msg, sizeof msg, "%s", carom_world_last_error(w));
-            const char *rest = strncmp(msg, "body_create: ", 13) == 0 ? msg + 13 : msg;
-            CFAIL("body_create: children[%d]: %s", i, rest);
-        }
-        if (!finite_c(c.position) || fabs(c.position.x) > RANGE_LENGTH_MAX || fabs(c.position.y) > RANGE_LENGTH_MAX ||
-            fabs(c.position.z) > RANGE_LENGTH_MAX)
-            CFAIL("body_create: children[%d].position must be finite (within 1e6 m)", i);
-        if (!quat_ok(c.orientation)) CFAIL("body_create: children[%d].orientation must be a finite unit quaternion", i);
-        if (!(isfinite(c.friction) && c.friction >= 0 && c.friction <= RANGE_FRICTION_MAX))
-            CFAIL("body_create: children[%d].friction must be in [0, 1e3]", i);
-        if (!(isfinite(c.restitution) && c.restitution >= 0 && c.restitution <= 1))
-            CFAIL("body_create: children[%d].restitution must be in [0, 1]", i);
-        if (!(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
-            CFAIL("body_create: children[%d].density must be in [1e-6, 1e9] kg/m^3", i);
-        char msg[160];
-        if (c.material && !material_valid(c.material, msg, sizeof msg)) CFAIL("body_create: children[%d].%s", i, msg);
-    }
-    return 1;
-#undef CFAIL
+    char msg[WORLD_ERROR_SIZE];
+    if (compound_children_reason(d->children, d->child_count, msg, sizeof msg)) return 1;
+    return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s", msg), 0;
 }
 
 static int check_body_def(carom_world *w, const carom_body_def *d)
@@ -236,7 +193,7 @@ static int build_compound(carom_world *w, const carom_body_def *d, shape *sh)
         return 0;
     }
     for (int i = 0; i < n; i++) {
-        carom_compound_child cd = child_def(d, i);
+        carom_compound_child cd = compound_child_at(d->children, i);
         build_shape(&cd.shape, &c->children[i]);
         c->count = i + 1; /* so a failure below frees what was built */
         char who[32];
@@ -280,10 +237,9 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     shape sh;
     build_shape(&d.shape, &sh);
     if (d.shape.type == CAROM_SHAPE_MESH) {
-        char err[160];
-        if (!d.mesh || d.mesh->size < offsetof(carom_mesh_def, two_sided) + sizeof(int)) {
-            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: mesh: def.mesh is %s",
-                       d.mesh ? "too small (use carom_mesh_def_default())" : "NULL");
+        char err[WORLD_ERROR_SIZE];
+        if (!mesh_def_reason(d.mesh, err, sizeof err)) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s", err);
             return null_id;
         }
         const carom_mesh_def *md = d.mesh;
@@ -295,10 +251,9 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
         }
     }
     if (d.shape.type == CAROM_SHAPE_HEIGHTFIELD) {
-        char err[160];
-        if (!d.heightfield || d.heightfield->size < offsetof(carom_heightfield_def, hole_count) + sizeof(int)) {
-            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: heightfield: def.heightfield is %s",
-                       d.heightfield ? "too small (use carom_heightfield_def_default())" : "NULL");
+        char err[WORLD_ERROR_SIZE];
+        if (!heightfield_def_reason(d.heightfield, err, sizeof err)) {
+            world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_create: %s", err);
             return null_id;
         }
         const carom_heightfield_def *hd = d.heightfield;

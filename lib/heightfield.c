@@ -18,24 +18,34 @@ void heightfield_free(height_field *h)
     free(h);
 }
 
+int heightfield_check(const double *heights, int rows, int columns, double cell_x, double cell_y, const int *holes,
+                      int hole_count, char *err, int err_size)
+{
+#define HF_CHECK_FAIL(...) do { if (err && err_size > 0) snprintf(err, (size_t)err_size, __VA_ARGS__); return 0; } while (0)
+    if (rows < 2 || columns < 2) HF_CHECK_FAIL("heightfield rows and columns: need at least 2 each (got %d x %d)", rows, columns);
+    if ((double)rows * columns > 1e8) HF_CHECK_FAIL("heightfield: too large (%d x %d)", rows, columns);
+    if (!heights) HF_CHECK_FAIL("heightfield heights: NULL");
+    if (!(cell_x >= RANGE_LENGTH_MIN && cell_x <= RANGE_LENGTH_MAX && cell_y >= RANGE_LENGTH_MIN && cell_y <= RANGE_LENGTH_MAX))
+        HF_CHECK_FAIL("heightfield cell: sizes must be in [1e-6, 1e6] m (got %g, %g)", cell_x, cell_y);
+    if ((columns - 1) * cell_x > RANGE_LENGTH_MAX || (rows - 1) * cell_y > RANGE_LENGTH_MAX)
+        HF_CHECK_FAIL("heightfield: wider than 1e6 m (%g x %g)", (columns - 1) * cell_x, (rows - 1) * cell_y);
+    for (int i = 0; i < rows * columns; i++)
+        if (!isfinite(heights[i]) || fabs(heights[i]) > RANGE_LENGTH_MAX)
+            HF_CHECK_FAIL("heightfield heights[%d]: must be finite (within 1e6 m; height %d counting from 1)", i, i + 1);
+    int cells = (rows - 1) * (columns - 1);
+    if (hole_count < 0 || (hole_count > 0 && !holes)) HF_CHECK_FAIL("heightfield holes: bad list (count %d)", hole_count);
+    for (int i = 0; i < hole_count; i++)
+        if (holes[i] < 0 || holes[i] >= cells) HF_CHECK_FAIL("heightfield holes[%d]: cell %d out of range 0..%d", i, holes[i], cells - 1);
+    return 1;
+#undef HF_CHECK_FAIL
+}
+
 height_field *heightfield_build(const double *heights, int rows, int columns, double cell_x, double cell_y,
                                 const int *holes, int hole_count, char *err, int err_size)
 {
 #define HF_FAIL(...) do { if (err && err_size > 0) snprintf(err, (size_t)err_size, __VA_ARGS__); return NULL; } while (0)
-    if (rows < 2 || columns < 2) HF_FAIL("heightfield rows and columns: need at least 2 each (got %d x %d)", rows, columns);
-    if ((double)rows * columns > 1e8) HF_FAIL("heightfield: too large (%d x %d)", rows, columns);
-    if (!heights) HF_FAIL("heightfield heights: NULL");
-    if (!(cell_x >= RANGE_LENGTH_MIN && cell_x <= RANGE_LENGTH_MAX && cell_y >= RANGE_LENGTH_MIN && cell_y <= RANGE_LENGTH_MAX))
-        HF_FAIL("heightfield cell: sizes must be in [1e-6, 1e6] m (got %g, %g)", cell_x, cell_y);
-    if ((columns - 1) * cell_x > RANGE_LENGTH_MAX || (rows - 1) * cell_y > RANGE_LENGTH_MAX)
-        HF_FAIL("heightfield: wider than 1e6 m (%g x %g)", (columns - 1) * cell_x, (rows - 1) * cell_y);
-    for (int i = 0; i < rows * columns; i++)
-        if (!isfinite(heights[i]) || fabs(heights[i]) > RANGE_LENGTH_MAX)
-            HF_FAIL("heightfield heights[%d]: must be finite (within 1e6 m)", i);
+    if (!heightfield_check(heights, rows, columns, cell_x, cell_y, holes, hole_count, err, err_size)) return NULL;
     int cells = (rows - 1) * (columns - 1);
-    if (hole_count < 0 || (hole_count > 0 && !holes)) HF_FAIL("heightfield holes: bad list (count %d)", hole_count);
-    for (int i = 0; i < hole_count; i++)
-        if (holes[i] < 0 || holes[i] >= cells) HF_FAIL("heightfield holes[%d]: cell %d out of range 0..%d", i, holes[i], cells - 1);
     height_field *h = calloc(1, sizeof *h);
     if (!h) HF_FAIL("heightfield: out of memory");
     h->rows = rows;

@@ -6,7 +6,11 @@
 
 #include "mesh.h"
 
-/* Copies and validates the input (err says which field is wrong). */
+/* 1 if the input is a valid height field, else 0 with err saying which
+ * field is wrong. */
+int heightfield_check(const double *heights, int rows, int columns, double cell_x, double cell_y, const int *holes,
+                      int hole_count, char *err, int err_size);
+/* Copies and validates the input (heightfield_check; err says which field is wrong). */
 height_field *heightfield_build(const double *heights, int rows, int columns, double cell_x, double cell_y,
                                 const int *holes, int hole_count, char *err, int err_size);
 void heightfield_free(height_field *h);

@@ -238,29 +238,40 @@ void mesh_free(tri_mesh *m)
     free(m);
 }
 
-tri_mesh *mesh_build(const double *vertices, int vertex_count, const int *triangles, int triangle_count,
-                     int two_sided, char *err, int err_size)
+int mesh_check(const double *vertices, int vertex_count, const int *triangles, int triangle_count, char *err,
+               int err_size)
 {
-    if (!vertices || vertex_count < 3) { fail(err, err_size, "mesh vertices: need at least 3 (got %d)", vertex_count, 0); return NULL; }
-    if (!triangles || triangle_count < 1) { fail(err, err_size, "mesh triangles: need at least 1 (got %d)", triangle_count, 0); return NULL; }
-    if (vertex_count > 100000000 || triangle_count > 100000000) { fail(err, err_size, "mesh: too large (%d vertices, %d triangles)", vertex_count, triangle_count); return NULL; }
+    if (!vertices || vertex_count < 3) { fail(err, err_size, "mesh vertices: need at least 3 (got %d)", vertex_count, 0); return 0; }
+    if (!triangles || triangle_count < 1) { fail(err, err_size, "mesh triangles: need at least 1 (got %d)", triangle_count, 0); return 0; }
+    if (vertex_count > 100000000 || triangle_count > 100000000) { fail(err, err_size, "mesh: too large (%d vertices, %d triangles)", vertex_count, triangle_count); return 0; }
     for (int i = 0; i < 3 * vertex_count; i++)
         if (!isfinite(vertices[i]) || fabs(vertices[i]) > RANGE_LENGTH_MAX) {
-            fail(err, err_size, "mesh vertices[%d]: coordinates must be finite (within 1e6 m)", i / 3, 0);
-            return NULL;
+            fail(err, err_size, "mesh vertices[%d]: coordinates must be finite (within 1e6 m; vertex %d counting from 1)", i / 3,
+                 i / 3 + 1);
+            return 0;
         }
     for (int t = 0; t < triangle_count; t++) {
         const int *v = triangles + 3 * t;
         for (int k = 0; k < 3; k++)
             if (v[k] < 0 || v[k] >= vertex_count) {
                 fail(err, err_size, "mesh triangles[%d]: vertex index %d out of range", t, v[k]);
-                return NULL;
+                return 0;
             }
         if (v[0] == v[1] || v[1] == v[2] || v[2] == v[0]) {
-            fail(err, err_size, "mesh triangles[%d]: repeats vertex %d", t, v[0] == v[1] || v[0] == v[2] ? v[0] : v[1]);
-            return NULL;
+            int repeated = v[0] == v[1] || v[0] == v[2] ? v[0] : v[1];
+            if (err && err_size > 0)
+                snprintf(err, (size_t)err_size, "mesh triangles[%d]: repeats vertex %d (triangle %d, vertex %d counting from 1)",
+                         t, repeated, t + 1, repeated + 1);
+            return 0;
         }
     }
+    return 1;
+}
+
+tri_mesh *mesh_build(const double *vertices, int vertex_count, const int *triangles, int triangle_count,
+                     int two_sided, char *err, int err_size)
+{
+    if (!mesh_check(vertices, vertex_count, triangles, triangle_count, err, err_size)) return NULL;
     tri_mesh *m = calloc(1, sizeof *m);
     if (!m) { fail(err, err_size, "mesh: out of memory", 0, 0); return NULL; }
     m->two_sided = two_sided != 0;

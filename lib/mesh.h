@@ -44,7 +44,12 @@ typedef struct height_field {
  * feature ids and ray hits. Return 0 to stop. */
 typedef int tri_visit_fn(void *ctx, const vec3 v[3], unsigned active_edges, uint32_t index);
 
-/* Copies and validates the input (err says which field is wrong); drops
+/* 1 if the input is a valid mesh (vertices finite within 1e6 m, indices in
+ * range, no triangle repeating a vertex), else 0 with err saying which field
+ * is wrong. Zero-area triangles are valid here (mesh_build drops them). */
+int mesh_check(const double *vertices, int vertex_count, const int *triangles, int triangle_count, char *err,
+               int err_size);
+/* Copies and validates the input (mesh_check; err says which field is wrong); drops
  * zero-area triangles; builds the tree by the surface-area heuristic. */
 tri_mesh *mesh_build(const double *vertices, int vertex_count, const int *triangles, int triangle_count,
                      int two_sided, char *err, int err_size);

@@ -71,7 +71,7 @@ int penalty_check(const step_context *ctx, char *msg, size_t msg_size)
             double r = penalty_explicit_stability(p->penalty_k, p->penalty_c, p->normal_mass, h);
             if (r >= PENALTY_EXPLICIT_MARGIN) {
                 snprintf(msg, msg_size,
-                           "step: explicit penalty spring k %g N/m, c %g N s/m on effective mass %g kg is "
+                           "explicit penalty spring k %g N/m, c %g N s/m on effective mass %g kg is "
                            "unstable at sub-step %g s (h^2 k/m + 2 h c/m = %.3g >= %.3g): use penalty_implicit = 1, "
                            "a smaller penalty_stiffness or more substeps",
                            p->penalty_k, p->penalty_c, p->normal_mass, h, 4.0 * r, 4.0 * PENALTY_EXPLICIT_MARGIN);

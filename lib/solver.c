@@ -599,7 +599,7 @@ static int check_penalty(carom_world *w, const step_context *ctx)
 {
     char msg[WORLD_ERROR_SIZE];
     if (!ctx->penalty || penalty_check(ctx, msg, sizeof msg)) return 1;
-    world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s", msg);
+    world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "step: %s", msg);
     return 0;
 }
 

@@ -4,6 +4,7 @@
  * finish claim them one at a time under the pool's lock. */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include "carom/carom_threads.h"
 
@@ -62,9 +63,19 @@ static void *worker_main(void *arg)
     return NULL;
 }
 
+CAROM_API carom_status carom_thread_pool_check(int workers, char *msg, size_t msg_size)
+{
+    int ok = workers >= 1 && workers <= CAROM_MAX_WORKERS;
+    if (msg && msg_size) {
+        if (ok) msg[0] = '\0';
+        else snprintf(msg, msg_size, "workers must be in 1..%d (got %d)", CAROM_MAX_WORKERS, workers);
+    }
+    return ok ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT;
+}
+
 CAROM_API carom_thread_pool *carom_thread_pool_create(int workers)
 {
-    if (workers < 1 || workers > CAROM_MAX_WORKERS) return NULL;
+    if (carom_thread_pool_check(workers, NULL, 0) != CAROM_OK) return NULL;
     carom_thread_pool *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     p->workers = workers;

@@ -44,6 +44,11 @@ CAROM_API const char *carom_world_last_error(const carom_world *world)
     return world ? world->error : "world is NULL";
 }
 
+CAROM_API const char *carom_world_last_error_reason(const carom_world *world)
+{
+    return world ? world->error + world->error_reason : "world is NULL";
+}
+
 /* ---- settings -------------------------------------------------------------- */
 
 /* Copies the caller's def (of its own compile-time size) over our defaults. */

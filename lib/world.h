@@ -82,6 +82,7 @@ struct carom_world {
     sensor_overlap *sensor_overlaps; /* sorted by sensor, then other */
     int sensor_overlap_count, sensor_overlap_capacity;
     char error[WORLD_ERROR_SIZE];
+    int error_reason;           /* error + error_reason: the message without the failing function's name */
     carom_status last_status;   /* the status world_fail last recorded */
 };
 

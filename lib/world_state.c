@@ -3,7 +3,18 @@
  * public API): errors, ids, waking, a body's removal. */
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 #include "world.h"
+
+/* The length of the function name and ": " that fmt (with its first
+ * argument, `first`, when fmt begins "%s: ") writes at the start of the
+ * message; 0 when fmt follows no such form. */
+static size_t name_length(const char *fmt, const char *first)
+{
+    if (strncmp(fmt, "%s: ", 4) == 0) return strlen(first) + 2;
+    size_t n = strspn(fmt, "abcdefghijklmnopqrstuvwxyz_");
+    return n > 0 && fmt[n] == ':' && fmt[n + 1] == ' ' ? n + 2 : 0;
+}
 
 carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
 {
@@ -13,8 +24,17 @@ carom_status world_fail(const carom_world *w, carom_status status, const char *f
         carom_world *mw = (carom_world *)(uintptr_t)w;
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(mw->error, sizeof mw->error, fmt, ap);
+        const char *first = NULL;
+        if (strncmp(fmt, "%s: ", 4) == 0) {
+            va_list peek;
+            va_copy(peek, ap);
+            first = va_arg(peek, const char *);
+            va_end(peek);
+        }
+        int n = vsnprintf(mw->error, sizeof mw->error, fmt, ap);
         va_end(ap);
+        size_t name = name_length(fmt, first), written = n > 0 ? strlen(mw->error) : 0;
+        mw->error_reason = (int)(name <= written ? name : written);
         mw->last_status = status;
     }
     return status;

@@ -3,7 +3,11 @@
 #ifndef CAROM_WORLD_STATE_H
 #define CAROM_WORLD_STATE_H
 
-/* Records a formatted error on the world; returns status for chaining. */
+/* Records a formatted error on the world; returns status for chaining.
+ * Every message begins with the name of the public function that failed
+ * and ": ", either in fmt itself ("body_set_mass: ...") or as fmt's leading
+ * "%s: " with the name the first argument; world_fail records where the
+ * reason after it starts (carom_world_last_error_reason). */
 carom_status world_fail(const carom_world *w, carom_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))

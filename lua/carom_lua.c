@@ -57,10 +57,7 @@ int clua_rawfield(lua_State *L, int t, const char *key)
 
 const char *clua_copy_error(const carom_world *world, char *buf, size_t size)
 {
-    const char *msg = carom_world_last_error(world);
-    const char *colon = strstr(msg, ": ");
-    if (colon && colon - msg < 40) msg = colon + 2; /* "body_set_mass: ..." */
-    snprintf(buf, size, "%s", msg);
+    snprintf(buf, size, "%s", carom_world_last_error_reason(world));
     return buf;
 }
 

@@ -71,8 +71,10 @@ typedef struct clua_shape {
 
 /* Pushes t[key] without metamethods; returns its type. */
 int clua_rawfield(lua_State *L, int t, const char *key);
-/* Copies the world's last error message, without its "function: " prefix,
- * into buf (the world's own buffer may not outlive the next allocation). */
+/* Copies the world's last error reason (carom_world_last_error_reason: the
+ * message without the C function's name; the caller names its own Lua
+ * function) into buf (the world's own buffer may not outlive the next
+ * allocation). */
 const char *clua_copy_error(const carom_world *world, char *buf, size_t size);
 
 /* Raises "bad argument #arg to 'fname' (message)". */

@@ -10,7 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "carom_lua.h"
-#include "ranges.h"
 
 const char *const clua_shape_names[] = {"sphere", "box", "capsule", "cylinder", "hull", "plane", "mesh", "heightfield", "compound", NULL};
 
@@ -66,14 +65,13 @@ static double required_field(lua_State *L, const char *fname, const char *key)
 }
 
 /* The library's own check of the def (as carom_body_create applies it to a
- * static body; the body's type is checked again there): its message, less
- * the "shape_def_check: " prefix, as the argument error. */
+ * static body; the body's type is checked again there): its reason as the
+ * argument error. */
 static void check_def(lua_State *L, const char *fname, const carom_shape_def *def)
 {
     char msg[256];
     if (carom_shape_def_check(def, CAROM_BODY_STATIC, msg, sizeof msg) == CAROM_OK) return;
-    const char *colon = strstr(msg, ": ");
-    clua_arg_error(L, 1, fname, "%s", colon ? colon + 2 : msg);
+    clua_arg_error(L, 1, fname, "%s", msg);
 }
 
 static int l_sphere(lua_State *L)
@@ -225,7 +223,10 @@ static int read_groups(lua_State *L, const char *fname, const char *what, int t,
     return (int)n;
 }
 
-/* The 1-based integers in v (n of them) as 0-based ints below limit. */
+/* The 1-based integers in v (n of them) as 0-based ints below limit. An
+ * index names an element of one of the script's lists (1..#list), so
+ * whether that element exists is the binding's question: the library sees
+ * only 0-based indices (and checks them again). */
 static int *to_indices(lua_State *L, const char *fname, const char *what, double *v, int n, int limit, int width)
 {
     int *ix = malloc(sizeof *ix * (size_t)(n > 0 ? n : 1));
@@ -261,13 +262,6 @@ static int l_mesh(lua_State *L)
     int nv = read_groups(L, "mesh", "vertices", 2, 3, &s->points);
     double *tv;
     int nt = read_groups(L, "mesh", "triangles", 3, 3, &tv);
-    if (nv < 3) clua_arg_error(L, 1, "mesh", "vertices: need at least 3, got %d", nv);
-    if (nt < 1) { free(tv); clua_arg_error(L, 1, "mesh", "triangles: need at least 1"); }
-    for (int i = 0; i < 3 * nv; i++)
-        if (!isfinite(s->points[i]) || fabs(s->points[i]) > RANGE_LENGTH_MAX) {
-            free(tv);
-            clua_arg_error(L, 1, "mesh", "vertices[%d] is not finite (or beyond 1e6 m)", i / 3 + 1);
-        }
     s->indices = to_indices(L, "mesh", "triangles", tv, 3 * nt, nv, 3);
     s->def = carom_shape_sphere(1);
     s->def.type = CAROM_SHAPE_MESH;
@@ -275,7 +269,10 @@ static int l_mesh(lua_State *L)
     s->mesh.vertices = s->points; s->mesh.vertex_count = nv;
     s->mesh.triangles = s->indices; s->mesh.triangle_count = nt;
     s->mesh.two_sided = two_sided;
-    /* the world checks the rest (repeated indices, zero area) when the body is made */
+    /* the library's rules (counts, coordinates, repeated indices); a mesh of
+     * only zero-area triangles is refused when the body is made */
+    char msg[256];
+    if (carom_mesh_def_check(&s->mesh, msg, sizeof msg) != CAROM_OK) clua_arg_error(L, 1, "mesh", "%s", msg);
     return 1;
 }
 
@@ -286,12 +283,10 @@ static int l_heightfield(lua_State *L)
     static const char *const keys[] = {"heights", "rows", "columns", "cell", "holes", NULL};
     check_shape_args(L, "heightfield", keys);
     normalise_positions(L, "heightfield", keys);
-    double rows = 0, columns = 0;
-    if (!clua_field_number(L, 1, "heightfield", "rows", &rows) || !(rows >= 2 && rows == floor(rows) && rows <= 1e8))
-        clua_arg_error(L, 1, "heightfield", "rows must be an integer >= 2");
-    if (!clua_field_number(L, 1, "heightfield", "columns", &columns) || !(columns >= 2 && columns == floor(columns) && columns <= 1e8))
-        clua_arg_error(L, 1, "heightfield", "columns must be an integer >= 2");
-    if (rows * columns > 1e8) clua_arg_error(L, 1, "heightfield", "rows x columns must be at most 1e8");
+    int rows = 0, columns = 0;
+    if (!clua_field_int(L, 1, "heightfield", "rows", &rows)) clua_arg_error(L, 1, "heightfield", "rows is required");
+    if (!clua_field_int(L, 1, "heightfield", "columns", &columns))
+        clua_arg_error(L, 1, "heightfield", "columns is required");
     double dx = 1, dy = 1;
     int ct = clua_rawfield(L, 1, "cell");
     if (ct == LUA_TNUMBER) dx = dy = lua_tonumber(L, -1);
@@ -302,8 +297,6 @@ static int l_heightfield(lua_State *L)
         lua_pop(L, 2);
     } else if (ct != LUA_TNIL) clua_arg_error(L, 1, "heightfield", "cell must be {dx, dy} or a number");
     lua_pop(L, 1);
-    if (!(dx >= RANGE_LENGTH_MIN && dx <= RANGE_LENGTH_MAX && dy >= RANGE_LENGTH_MIN && dy <= RANGE_LENGTH_MAX))
-        clua_arg_error(L, 1, "heightfield", "cell sizes must be in [1e-6, 1e6] m");
     if (clua_rawfield(L, 1, "heights") != LUA_TTABLE) clua_arg_error(L, 1, "heightfield", "heights must be a list of numbers");
     int ht = lua_gettop(L);
     int has_holes = clua_rawfield(L, 1, "holes") != LUA_TNIL;
@@ -311,16 +304,16 @@ static int l_heightfield(lua_State *L)
     int hl = lua_gettop(L);
     clua_shape *s = new_shape(L);
     int n = read_groups(L, "heightfield", "heights", ht, 1, &s->points);
-    if (n != (int)(rows * columns))
-        clua_arg_error(L, 1, "heightfield", "heights: need rows x columns = %d numbers, got %d", (int)(rows * columns), n);
-    for (int i = 0; i < n; i++)
-        if (!isfinite(s->points[i]) || fabs(s->points[i]) > RANGE_LENGTH_MAX)
-            clua_arg_error(L, 1, "heightfield", "heights[%d] is not finite (or beyond 1e6 m)", i + 1);
+    /* the library reads rows x columns heights: the list must hold that many
+     * (how many rows and columns may be is the library's question) */
+    long long want = (long long)rows * columns;
+    if (n != want) clua_arg_error(L, 1, "heightfield", "heights: need rows x columns = %lld numbers, got %d", want, n);
     int nh = 0;
     if (has_holes) {
         double *hv;
         nh = read_groups(L, "heightfield", "holes", hl, 1, &hv);
-        s->indices = to_indices(L, "heightfield", "holes", hv, nh, (int)((rows - 1) * (columns - 1)), 1);
+        long long cells = (long long)(rows > 1 ? rows - 1 : 0) * (columns > 1 ? columns - 1 : 0);
+        s->indices = to_indices(L, "heightfield", "holes", hv, nh, (int)cells, 1);
     }
     s->def = carom_shape_sphere(1);
     s->def.type = CAROM_SHAPE_HEIGHTFIELD;
@@ -329,6 +322,9 @@ static int l_heightfield(lua_State *L)
     s->heightfield.rows = (int)rows; s->heightfield.columns = (int)columns;
     s->heightfield.cell_x = dx; s->heightfield.cell_y = dy;
     s->heightfield.holes = s->indices; s->heightfield.hole_count = nh;
+    char msg[256];
+    if (carom_heightfield_def_check(&s->heightfield, msg, sizeof msg) != CAROM_OK)
+        clua_arg_error(L, 1, "heightfield", "%s", msg);
     return 1;
 }
 
@@ -346,8 +342,7 @@ static int l_compound(lua_State *L)
         if (!lua_isinteger(L, -1) || lua_tointeger(L, -1) < 1 || lua_tointeger(L, -1) > n)
             clua_arg_error(L, 1, "compound", "takes a list of children {shape = ..., position = ...}, no named options");
     }
-    if (n < 1) clua_arg_error(L, 1, "compound", "needs at least one child");
-    if (n > 256) clua_arg_error(L, 1, "compound", "takes at most 256 children, got %d", (int)n);
+    if (n > INT_MAX / 2) clua_arg_error(L, 1, "compound", "%lld children are too many to read", (long long)n);
     /* the hull children's points, all in one buffer */
     size_t total = 0;
     for (lua_Integer i = 1; i <= n; i++) {
@@ -365,8 +360,8 @@ static int l_compound(lua_State *L)
     }
     clua_shape *s = new_shape(L);
     int self = lua_gettop(L);
-    s->children = calloc((size_t)n, sizeof *s->children);
-    s->materials = calloc((size_t)n, sizeof *s->materials);
+    s->children = calloc((size_t)(n > 0 ? n : 1), sizeof *s->children);
+    s->materials = calloc((size_t)(n > 0 ? n : 1), sizeof *s->materials);
     s->points = malloc(sizeof *s->points * (total > 0 ? total : 1));
     if (!s->children || !s->points || !s->materials) return luaL_error(L, "compound: out of memory");
     size_t used = 0;
@@ -387,12 +382,9 @@ static int l_compound(lua_State *L)
         lua_pop(L, 1);
         clua_field_vec3(L, ct, who, "position", &c.position);
         clua_field_quat(L, ct, who, "orientation", &c.orientation);
-        if (clua_field_number(L, ct, who, "friction", &c.friction) && !(c.friction >= 0 && c.friction <= RANGE_FRICTION_MAX))
-            clua_arg_error(L, ct, who, "friction must be in [0, 1e3]");
-        if (clua_field_number(L, ct, who, "restitution", &c.restitution) && !(c.restitution >= 0 && c.restitution <= 1))
-            clua_arg_error(L, ct, who, "restitution must be in [0, 1]");
-        if (clua_field_number(L, ct, who, "density", &c.density) && !(c.density >= RANGE_DENSITY_MIN && c.density <= RANGE_DENSITY_MAX))
-            clua_arg_error(L, ct, who, "density must be in [1e-6, 1e9] kg/m^3");
+        clua_field_number(L, ct, who, "friction", &c.friction);
+        clua_field_number(L, ct, who, "restitution", &c.restitution);
+        clua_field_number(L, ct, who, "density", &c.density);
         if (clua_rawfield(L, ct, "material") != LUA_TNIL) {
             const carom_material *m = luaL_testudata(L, -1, CLUA_MATERIAL_MT);
             if (!m) clua_arg_error(L, ct, who, "material must be made by carom.material{...}, got %s", luaL_typename(L, -1));
@@ -406,6 +398,9 @@ static int l_compound(lua_State *L)
     }
     s->def = carom_shape_sphere(1);
     s->def.type = CAROM_SHAPE_COMPOUND;
+    char msg[256];
+    if (carom_compound_check(s->children, s->child_count, msg, sizeof msg) != CAROM_OK)
+        clua_arg_error(L, 1, "compound", "%s", msg);
     return 1;
 }
 

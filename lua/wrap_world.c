@@ -99,20 +99,19 @@ static void read_world_options(lua_State *L, int arg, const char *fname, carom_w
         else if (f->kind == 'i') clua_field_int(L, arg, fname, f->key, (int *)(void *)p);
         else clua_field_bool(L, arg, fname, f->key, (int *)(void *)p);
     }
-    double dt = *fixed_dt;
-    if (clua_field_number(L, arg, fname, "dt", &dt) && !(dt > 0 && dt <= 1))
-        clua_arg_error(L, arg, fname, "dt must be in (0, 1] seconds");
-    int ms = *max_steps;
-    if (clua_field_int(L, arg, fname, "max_steps", &ms) && !(ms >= 1 && ms <= 100000))
-        clua_arg_error(L, arg, fname, "max_steps must be in 1..100000");
-    int th = *threads;
-    if (clua_field_int(L, arg, fname, "threads", &th) && !(th >= 1 && th <= CAROM_MAX_WORKERS))
-        clua_arg_error(L, arg, fname, "threads must be in 1..%d", CAROM_MAX_WORKERS);
+    /* the ranges are the library's: advance()'s clock (carom_fixed_step, with
+     * no frame time: dt and max_steps alone), the pool's worker count, the def */
     char msg[256];
-    if (carom_world_def_check(&d, msg, sizeof msg) != CAROM_OK) {
-        const char *colon = strstr(msg, ": ");
-        clua_arg_error(L, arg, fname, "%s", colon && colon - msg < 24 ? colon + 2 : msg);
-    }
+    double dt = *fixed_dt, no_time = 0;
+    int ms = *max_steps, no_steps;
+    clua_field_number(L, arg, fname, "dt", &dt);
+    clua_field_int(L, arg, fname, "max_steps", &ms);
+    if (carom_fixed_step(dt, ms, 0, &no_time, &no_steps, msg, sizeof msg) != CAROM_OK)
+        clua_arg_error(L, arg, fname, "%s", msg);
+    int th = *threads;
+    if (clua_field_int(L, arg, fname, "threads", &th) && carom_thread_pool_check(th, msg, sizeof msg) != CAROM_OK)
+        clua_arg_error(L, arg, fname, "threads: %s", msg);
+    if (carom_world_def_check(&d, msg, sizeof msg) != CAROM_OK) clua_arg_error(L, arg, fname, "%s", msg);
     *def = d;
     *fixed_dt = dt;
     *max_steps = ms;
@@ -467,16 +466,21 @@ static int world_advance(lua_State *L)
     clua_world *lw = clua_check_world(L, 1, "advance");
     if (lw->stepping) return luaL_error(L, "advance: cannot step a world from inside its own contact callback");
     double frame = clua_check_number(L, 2, "advance");
-    if (frame < 0) clua_arg_error(L, 2, "advance", "frame time must not be negative");
-    lua_settop(L, 1);
-    lw->accumulator += frame;
+    double after = lw->accumulator;
     int steps = 0;
-    while (lw->accumulator >= lw->fixed_dt && steps < lw->max_steps) {
+    char msg[256];
+    if (carom_fixed_step(lw->fixed_dt, lw->max_steps, frame, &after, &steps, msg, sizeof msg) != CAROM_OK)
+        clua_arg_error(L, 2, "advance", "%s", msg);
+    lua_settop(L, 1);
+    /* The clock's accumulator counts down one step at a time while the steps
+     * run (the same subtractions carom_fixed_step made), so a callback error
+     * that stops the loop leaves the steps not taken in it. */
+    lw->accumulator += frame;
+    for (int i = 0; i < steps; i++) {
         lw->accumulator -= lw->fixed_dt;
-        steps++;
         step_once(L, lw, lw->fixed_dt, 0);
     }
-    if (lw->accumulator >= lw->fixed_dt) lw->accumulator = fmod(lw->accumulator, lw->fixed_dt);
+    lw->accumulator = after;
     lua_pushinteger(L, steps);
     lua_pushnumber(L, lw->accumulator / lw->fixed_dt);
     return 2;

@@ -89,25 +89,26 @@ test("ray casts hit a height field where its heights are, and miss its holes", f
 end)
 
 test("bad input is refused naming the field", function()
-  raises("vertices[2] is not finite", carom.mesh, { vertices = {{0, 0, 0}, {0 / 0, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
-  raises("vertices[2] is not finite", carom.mesh, { vertices = {{0, 0, 0}, {math.huge, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
+  raises("vertices[1]: coordinates must be finite (within 1e6 m; vertex 2 counting from 1)", carom.mesh, { vertices = {{0, 0, 0}, {0 / 0, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
+  raises("vertex 2 counting from 1", carom.mesh, { vertices = {{0, 0, 0}, {math.huge, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} })
   raises("triangles[1]: index 4", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 4}} })
   raises("triangles[1]: index 0", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{0, 1, 2}} })
   raises("triangles: need at least 1", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {} })
   raises("vertices[1] is not a list of 3 numbers", carom.mesh, { vertices = {{0, 0}}, triangles = {{1, 2, 3}} })
   raises("unknown option", carom.mesh, { vertices = {}, triangles = {}, colour = 1 })
   local world = carom.world{}
-  local repeated = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 2}} }
-  raises("repeats", world.add_body, world, { type = "static", shape = repeated })
+  -- the library's rules apply when the descriptor is made (carom_mesh_def_check)
+  raises("triangles[0]: repeats vertex 1 (triangle 1, vertex 2 counting from 1)", carom.mesh, { vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 2}} })
   local flat = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}, triangles = {{1, 2, 3}} }
   raises("zero area", world.add_body, world, { type = "static", shape = flat })
   local ok = carom.mesh{ vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, triangles = {{1, 2, 3}} }
   raises("static or kinematic", world.add_body, world, { shape = ok })
-  raises("heights[2] is not finite", carom.heightfield, { heights = {0, 0 / 0, 0, 0}, rows = 2, columns = 2 })
+  raises("heights[1]: must be finite (within 1e6 m; height 2 counting from 1)", carom.heightfield, { heights = {0, 0 / 0, 0, 0}, rows = 2, columns = 2 })
   raises("heights: need rows x columns = 4", carom.heightfield, { heights = {0, 0, 0}, rows = 2, columns = 2 })
-  raises("rows must be an integer", carom.heightfield, { heights = {0, 0}, rows = 1, columns = 2 })
+  raises("rows and columns: need at least 2 each (got 1 x 2)", carom.heightfield, { heights = {0, 0}, rows = 1, columns = 2 })
+  raises("rows must be an integer", carom.heightfield, { heights = {0, 0}, rows = 1.5, columns = 2 })
   raises("holes[1]: 2 is not an integer in 1..1", carom.heightfield, { heights = {0, 0, 0, 0}, rows = 2, columns = 2, holes = {2} })
-  raises("cell sizes", carom.heightfield, { heights = {0, 0, 0, 0}, rows = 2, columns = 2, cell = {0, 1} })
+  raises("cell: sizes must be in [1e-6, 1e6] m (got 0, 1)", carom.heightfield, { heights = {0, 0, 0, 0}, rows = 2, columns = 2, cell = {0, 1} })
   assert(world:body_count() == 0, "the world is unchanged")
 end)
 
@@ -150,7 +151,7 @@ test("compound: mass, a table standing on a mesh, the child in ray casts and eve
   local mine = (e.a == bell) and e.child_a or e.child_b
   assert(mine == 2, "the +x sphere lands first (tilted down at +x): child " .. tostring(mine))
   -- bad children
-  raises("needs at least one child", carom.compound, {})
+  raises("a compound needs children (got 0)", carom.compound, {})
   raises("child 1: shape must be convex", carom.compound, { { shape = carom.plane{} } })
   raises("child 2 is not a table", carom.compound, { { shape = carom.sphere{ radius = 1 } }, 3 })
   raises("density must be in", carom.compound, { { shape = carom.sphere{ radius = 1 }, density = 0 } })

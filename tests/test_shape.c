@@ -1191,6 +1191,122 @@ static void test_shape_def_check(void **state)
     carom_world_destroy(w);
 }
 
+/* ---- carom_mesh_def_check, carom_heightfield_def_check, carom_compound_check ---- */
+
+/* A static body with this data is created exactly when the check accepts it
+ * (create_ok: what body_create says, for the one documented difference); a
+ * refusal names the bad field. */
+static void expect_data(carom_world *w, carom_status st, const char *msg, carom_body_def *bd, int check_ok, int create_ok,
+                        const char *words)
+{
+    assert_int_equal(st, check_ok ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT);
+    if (check_ok) assert_string_equal(msg, "");
+    else if (!strstr(msg, words)) fail_msg("message '%s' lacks '%s'", msg, words);
+    int before = carom_world_body_count(w);
+    carom_body_id id = carom_body_create(w, bd);
+    assert_int_equal(carom_body_is_valid(w, id), create_ok);
+    assert_int_equal(carom_world_body_count(w), before + create_ok);
+    if (!create_ok && !check_ok) assert_non_null(strstr(carom_world_last_error_reason(w), msg)); /* the same reason */
+}
+
+static void test_data_checks(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    char msg[256];
+    /* meshes */
+    double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0};
+    double bad_v[] = {0, 0, 0, 1, 0, 0, 2e6, 1, 0};
+    int ok_t[] = {0, 1, 2}, out_t[] = {0, 1, 3}, rep_t[] = {0, 2, 2}, flat_t[] = {0, 1, 3};
+    struct { const double *v; int nv; const int *t; int nt; int check_ok, create_ok; const char *words; } meshes[] = {
+        {v, 3, ok_t, 1, 1, 1, ""},
+        {v, 2, ok_t, 1, 0, 0, "vertices: need at least 3"},
+        {v, 3, ok_t, 0, 0, 0, "triangles: need at least 1"},
+        {bad_v, 3, ok_t, 1, 0, 0, "vertices[2]: coordinates must be finite (within 1e6 m; vertex 3 counting from 1)"},
+        {v, 3, out_t, 1, 0, 0, "vertex index 3 out of range"},
+        {v, 3, rep_t, 1, 0, 0, "triangles[0]: repeats vertex 2 (triangle 1, vertex 3 counting from 1)"},
+        {v, 4, flat_t, 1, 1, 0, ""}, /* only zero-area triangles: body_create refuses it */
+    };
+    for (size_t i = 0; i < sizeof meshes / sizeof meshes[0]; i++) {
+        carom_mesh_def md = carom_mesh_def_default();
+        md.vertices = meshes[i].v; md.vertex_count = meshes[i].nv;
+        md.triangles = meshes[i].t; md.triangle_count = meshes[i].nt;
+        carom_body_def bd = carom_body_def_default();
+        bd.type = CAROM_BODY_STATIC;
+        bd.shape.type = CAROM_SHAPE_MESH;
+        bd.mesh = &md;
+        strcpy(msg, "untouched");
+        carom_status st = carom_mesh_def_check(&md, msg, sizeof msg);
+        expect_data(w, st, msg, &bd, meshes[i].check_ok, meshes[i].create_ok, meshes[i].words);
+    }
+    assert_int_equal(carom_mesh_def_check(NULL, msg, sizeof msg), CAROM_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(msg, "NULL"));
+    carom_mesh_def small = carom_mesh_def_default();
+    small.size = 8;
+    assert_int_equal(carom_mesh_def_check(&small, NULL, 0), CAROM_ERROR_INVALID_ARGUMENT);
+    /* height fields */
+    double h[] = {0, 0.5, 1, 0, 0, 0}, bad_h[] = {0, 0, 1.0 / 0.0, 0, 0, 0};
+    int hole_ok[] = {1}, hole_out[] = {2};
+    struct { const double *h; int rows, cols; double cx; const int *holes; int nh; int ok; const char *words; } fields[] = {
+        {h, 2, 3, 1.0, NULL, 0, 1, ""},
+        {h, 2, 3, 1.0, hole_ok, 1, 1, ""},
+        {h, 1, 6, 1.0, NULL, 0, 0, "need at least 2 each (got 1 x 6)"},
+        {h, 2, 3, 0.0, NULL, 0, 0, "cell: sizes must be in [1e-6, 1e6] m"},
+        {bad_h, 2, 3, 1.0, NULL, 0, 0, "heights[2]: must be finite (within 1e6 m; height 3 counting from 1)"},
+        {h, 2, 3, 1.0, hole_out, 1, 0, "holes[0]: cell 2 out of range 0..1"},
+    };
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) {
+        carom_heightfield_def hd = carom_heightfield_def_default();
+        hd.heights = fields[i].h; hd.rows = fields[i].rows; hd.columns = fields[i].cols;
+        hd.cell_x = fields[i].cx; hd.holes = fields[i].holes; hd.hole_count = fields[i].nh;
+        carom_body_def bd = carom_body_def_default();
+        bd.type = CAROM_BODY_STATIC;
+        bd.shape.type = CAROM_SHAPE_HEIGHTFIELD;
+        bd.heightfield = &hd;
+        strcpy(msg, "untouched");
+        carom_status st = carom_heightfield_def_check(&hd, msg, sizeof msg);
+        expect_data(w, st, msg, &bd, fields[i].ok, fields[i].ok, fields[i].words);
+    }
+    assert_int_equal(carom_heightfield_def_check(NULL, NULL, 0), CAROM_ERROR_INVALID_ARGUMENT);
+    /* compounds: the second child carries the fault, named by both numberings */
+    struct { int field; double value; int ok; const char *words; } kids[] = {
+        {0, 0, 1, ""},
+        {1, -1, 0, "children[1].friction must be in [0, 1e3] (child 2 counting from 1)"},
+        {2, 1.5, 0, "children[1].restitution must be in [0, 1]"},
+        {3, 0, 0, "children[1].density must be in [1e-6, 1e9] kg/m^3"},
+        {4, 2e6, 0, "children[1].position must be finite (within 1e6 m)"},
+        {5, -1, 0, "children[1]: sphere radius -1 is outside"},
+        {6, 0, 0, "children[1].shape must be convex"},
+    };
+    for (size_t i = 0; i < sizeof kids / sizeof kids[0]; i++) {
+        carom_compound_child c[2] = {carom_compound_child_default(carom_shape_box(0.5, 0.5, 0.5)),
+                                     carom_compound_child_default(carom_shape_sphere(0.25))};
+        c[1].position = vec(1, 0, 0);
+        switch (kids[i].field) {
+        case 1: c[1].friction = kids[i].value; break;
+        case 2: c[1].restitution = kids[i].value; break;
+        case 3: c[1].density = kids[i].value; break;
+        case 4: c[1].position.x = kids[i].value; break;
+        case 5: c[1].shape = carom_shape_sphere(kids[i].value); break;
+        case 6: c[1].shape = carom_shape_plane(0, 0, 1, 0); break;
+        default: break;
+        }
+        carom_body_def bd = carom_body_def_default();
+        bd.shape.type = CAROM_SHAPE_COMPOUND;
+        bd.children = c;
+        bd.child_count = 2;
+        strcpy(msg, "untouched");
+        carom_status st = carom_compound_check(c, 2, msg, sizeof msg);
+        expect_data(w, st, msg, &bd, kids[i].ok, kids[i].ok, kids[i].words);
+    }
+    carom_compound_child one = carom_compound_child_default(carom_shape_sphere(1));
+    assert_int_equal(carom_compound_check(&one, 0, msg, sizeof msg), CAROM_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(msg, "a compound needs children (got 0)"));
+    assert_int_equal(carom_compound_check(NULL, 1, NULL, 0), CAROM_ERROR_INVALID_ARGUMENT);
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1214,6 +1330,7 @@ int main(void)
         cmocka_unit_test(test_bounding_radius),
         cmocka_unit_test(test_ray_casts),
         cmocka_unit_test(test_shape_def_check),
+        cmocka_unit_test(test_data_checks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

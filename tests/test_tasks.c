@@ -361,10 +361,32 @@ static void test_broken_hooks_are_caught(void **state)
 #endif
 }
 
+/* The reference pool's worker count: the check and the constructor agree at
+ * and beyond both ends of 1..CAROM_MAX_WORKERS. */
+static void test_pool_worker_range(void **state)
+{
+    (void)state;
+    const int counts[] = {-1, 0, 1, 2, CAROM_MAX_WORKERS, CAROM_MAX_WORKERS + 1};
+    for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+        int n = counts[i], ok = n >= 1 && n <= CAROM_MAX_WORKERS;
+        char msg[128] = "untouched";
+        assert_int_equal(carom_thread_pool_check(n, msg, sizeof msg), ok ? CAROM_OK : CAROM_ERROR_INVALID_ARGUMENT);
+        if (ok) assert_string_equal(msg, "");
+        else assert_non_null(strstr(msg, "workers must be in 1..64"));
+        carom_thread_pool *pool = n <= 4 ? carom_thread_pool_create(n) : NULL; /* (not 64 threads) */
+        if (n <= 4) assert_int_equal(pool != NULL, ok);
+        if (pool) assert_int_equal(carom_thread_pool_workers(pool), n);
+        carom_thread_pool_destroy(pool);
+    }
+    assert_null(carom_thread_pool_create(CAROM_MAX_WORKERS + 1));
+    assert_int_equal(carom_thread_pool_check(0, NULL, 0), CAROM_ERROR_INVALID_ARGUMENT);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hook_validation),
+        cmocka_unit_test(test_pool_worker_range),
         cmocka_unit_test(test_broken_hooks_are_caught),
         cmocka_unit_test(test_any_worker_count_gives_the_same_bits),
         cmocka_unit_test(test_presets_and_switches_agree_across_workers),

@@ -25,6 +25,45 @@ static void test_version_and_status(void **state)
     assert_non_null(strstr(carom_status_string(CAROM_ERROR_STALE_ID), "stale"));
 }
 
+/* The reason is the message after the failing function's name, for a name
+ * written in the format ("body_set_friction: ...") and one passed as its
+ * first argument ("%s: ..." with fn), for every failing call below; a new
+ * world has neither, a NULL world says so. */
+static void expect_reason(const carom_world *w, const char *name, const char *words)
+{
+    const char *msg = carom_world_last_error(w), *reason = carom_world_last_error_reason(w);
+    size_t n = strlen(name);
+    if (strncmp(msg, name, n) != 0 || msg[n] != ':') fail_msg("message '%s' does not begin with %s:", msg, name);
+    assert_string_equal(reason, msg + n + 2);
+    assert_non_null(strstr(reason, words));
+}
+
+static void test_last_error_reason(void **state)
+{
+    (void)state;
+    carom_world *w = world_default();
+    assert_string_equal(carom_world_last_error_reason(w), "");
+    assert_string_equal(carom_world_last_error_reason(NULL), "world is NULL");
+    carom_body_id ball = add_sphere(w, 0, 0, 1, 0.5);
+    assert_int_equal(carom_body_set_friction(w, ball, -1), CAROM_ERROR_INVALID_ARGUMENT);
+    expect_reason(w, "body_set_friction", "friction");
+    carom_body_def d = carom_body_def_default();
+    d.shape = carom_shape_sphere(-1); /* shape_def_check's "%s: %s" with fn "body_create" */
+    assert_true(carom_body_id_is_null(carom_body_create(w, &d)));
+    expect_reason(w, "body_create", "sphere radius -1 is outside");
+    carom_vec3 p;
+    carom_body_id stale = ball;
+    stale.generation += 1; /* the id lookup's "%s: ..." */
+    assert_int_equal(carom_body_get_position(w, stale, &p), CAROM_ERROR_STALE_ID);
+    expect_reason(w, "body_get_position", "");
+    assert_int_equal(carom_world_step(w, 2.0), CAROM_ERROR_INVALID_ARGUMENT);
+    expect_reason(w, "step", "dt");
+    /* a success leaves the last failure as it was */
+    assert_int_equal(carom_body_get_position(w, ball, &p), CAROM_OK);
+    expect_reason(w, "step", "dt");
+    carom_world_destroy(w);
+}
+
 static void test_id_generations(void **state)
 {
     (void)state;
@@ -463,6 +502,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version_and_status),
+        cmocka_unit_test(test_last_error_reason),
         cmocka_unit_test(test_id_generations),
         cmocka_unit_test(test_store_stays_dense),
         cmocka_unit_test(test_mass_properties),

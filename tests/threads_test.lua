@@ -39,12 +39,12 @@ test("1, 3 and 2 threads step bit for bit alike", function()
 end)
 
 test("bad thread counts are refused", function()
-  raises("threads must be in 1..64", carom.world, { threads = 0 })
-  raises("threads must be in 1..64", carom.world, { threads = 65 })
+  raises("threads: workers must be in 1..64 (got 0)", carom.world, { threads = 0 })
+  raises("threads: workers must be in 1..64 (got 65)", carom.world, { threads = 65 })
   raises("threads must be an integer", carom.world, { threads = 1.5 })
   raises("threads must be a number", carom.world, { threads = "two" })
   local w = carom.world{ threads = 2 }
-  raises("threads must be in 1..64", w.configure, w, { threads = -1 })
+  raises("threads: workers must be in 1..64 (got -1)", w.configure, w, { threads = -1 })
   assert(w:settings().threads == 2, "a refused configure changes nothing")
 end)
 

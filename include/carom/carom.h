@@ -841,9 +841,46 @@ CAROM_API carom_status carom_body_get_material(const carom_world *world, carom_b
  * carom_body_create applies to it (lengths in range, a hull's point count
  * and coordinates, a plane only static, a mesh or height field not
  * dynamic; the data of a mesh, height field or compound come with the body
- * def and are checked there). On error writes a readable message to msg
- * (if not NULL) and returns CAROM_ERROR_INVALID_ARGUMENT. */
+ * def and are checked there, or alone by carom_mesh_def_check and the
+ * functions after it). On error writes the reason (without a function
+ * name, as carom_world_def_check) to msg (if not NULL) and returns
+ * CAROM_ERROR_INVALID_ARGUMENT. */
 CAROM_API carom_status carom_shape_def_check(const carom_shape_def *def, carom_body_type type, char *msg, size_t msg_size);
+
+/* ---- structured errors and the data checks ------------------------------- */
+
+/* The last error's reason: carom_world_last_error without the name of the
+ * function that failed and its ": " ("" if none; "world is NULL" for NULL).
+ * With the status the call returned, a binding reports the failure under
+ * its own function's name without reading the message. */
+CAROM_API const char *carom_world_last_error_reason(const carom_world *world);
+/* Check the data of a mesh, a height field or a compound's children alone,
+ * by the rules carom_body_create applies to them (sizes, counts, indices,
+ * coordinates and heights finite and within 1e6 m, cell sizes, each child's
+ * shape, pose, friction, restitution, density and material). A mesh's
+ * zero-area triangles pass here: body_create drops them, and refuses a mesh
+ * that has only those. On error write the reason (carom_shape_def_check's
+ * style) to msg (if not NULL) and return CAROM_ERROR_INVALID_ARGUMENT. */
+CAROM_API carom_status carom_mesh_def_check(const carom_mesh_def *def, char *msg, size_t msg_size);
+CAROM_API carom_status carom_heightfield_def_check(const carom_heightfield_def *def, char *msg, size_t msg_size);
+CAROM_API carom_status carom_compound_check(const carom_compound_child *children, int count, char *msg,
+                                            size_t msg_size);
+
+/* ---- a fixed-step clock -------------------------------------------------- */
+
+#define CAROM_FIXED_STEP_MAX_STEPS 100000
+/* For a host that steps by frame time: adds frame_time (finite, >= 0 s) to
+ * *accumulator (finite, >= 0) and sets *steps to the whole steps of dt
+ * (0 < dt <= 1 s) to take now, at most max_steps (1..CAROM_FIXED_STEP_MAX_STEPS).
+ * The accumulator keeps the rest; a backlog beyond max_steps is dropped
+ * (only its fraction of a step is kept) rather than chased, which would
+ * only fall further behind. *accumulator / dt afterwards is in [0, 1): how
+ * far real time is into the next step, to interpolate poses when drawing.
+ * With frame_time 0 it checks dt and max_steps alone. On error writes the
+ * reason to msg (if not NULL), changes nothing and returns
+ * CAROM_ERROR_INVALID_ARGUMENT. */
+CAROM_API carom_status carom_fixed_step(double dt, int max_steps, double frame_time, double *accumulator, int *steps,
+                                        char *msg, size_t msg_size);
 
 #ifdef __cplusplus
 }

@@ -38,6 +38,11 @@ CAROM_API void *carom_thread_pool_enqueue(carom_task_fn *task, int item_count, i
                                           void *pool);
 CAROM_API void carom_thread_pool_finish(void *task, void *pool);
 
+/* Checks a worker count for carom_thread_pool_create: CAROM_OK for
+ * 1..CAROM_MAX_WORKERS, else CAROM_ERROR_INVALID_ARGUMENT with the reason
+ * in msg (if not NULL). */
+CAROM_API carom_status carom_thread_pool_check(int workers, char *msg, size_t msg_size);
+
 #ifdef __cplusplus
 }
 #endif
