@@ -1,6 +1,7 @@
 /* world_state.c - the world's internal services, for the stages and the
  * public API files alike (which call in; nothing here calls out to the
  * public API): errors, ids, waking, a body's removal. */
+#include <assert.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -34,6 +35,9 @@ carom_status world_fail(const carom_world *w, carom_status status, const char *f
         int n = vsnprintf(mw->error, sizeof mw->error, fmt, ap);
         va_end(ap);
         size_t name = name_length(fmt, first), written = n > 0 ? strlen(mw->error) : 0;
+        /* a format without the name would hand the name to the reason:
+         * stop a debug build at the call that breaks the convention */
+        assert(name > 0 && "world_fail: the format must begin \"name: \" or \"%s: \" (the name first)");
         mw->error_reason = (int)(name <= written ? name : written);
         mw->last_status = status;
     }
