@@ -1,5 +1,5 @@
--- forces_materials_test.lua - the Lua side of torques, forces at a point,
--- contact force events and materials (issue "what a game script needs"):
+-- wrap_material_test.lua - lua/wrap_material.c: the Lua side of torques,
+-- forces at a point, contact force events and materials (issue "what a game script needs"):
 -- answers worked from first principles (L = tau t, p = F t, a resting box
 -- presses with m g, a rolling ball slows at c g), and the errors of every
 -- new call. Run by `make check` with carom-run --test.

@@ -1,7 +1,8 @@
--- mesh_test.lua - carom.mesh and carom.heightfield from Lua: a ball rolls on
--- each as on a plane (the same path, computed in the same run), ray casts hit
+-- wrap_shape_test.lua - lua/wrap_shape.c's level geometry: carom.mesh,
+-- carom.heightfield and carom.compound from Lua: a ball rolls on each field
+-- as on a plane (the same path, computed in the same run), ray casts hit
 -- them where the geometry says, and every bad input is refused naming the
--- field. Run by `make check` as `carom-run --test tests/mesh_test.lua`.
+-- field. Run by `make check` as `carom-run --test tests/wrap_shape_test.lua`.
 local carom = require "carom"
 local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
 local test, raises = T.test, T.raises

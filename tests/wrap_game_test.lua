@@ -1,5 +1,5 @@
--- game_api_test.lua - the Lua side of filtering and queries (issue "what a
--- game script needs"): add_body's category/mask/group, set_filter, every
+-- wrap_game_test.lua - lua/wrap_game.c: the Lua side of filtering and
+-- queries (issue "what a game script needs"): add_body's category/mask/group, set_filter, every
 -- query with a mask and with a filter function, and their errors. Values are
 -- the geometry worked by hand. Run by `make check` with carom-run --test.
 local carom = require "carom"
