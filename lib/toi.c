@@ -234,11 +234,21 @@ static int may_need_sweep(const carom_world *w, const step_context *step, int sl
     int k = s->solver_index[slot];
     if (s->type[slot] != CAROM_BODY_DYNAMIC || !(s->flags[slot] & BODY_AWAKE) || k <= 0) return 0;
     if (s->flags[slot] & BODY_BULLET) return 1;
-    xform x0 = w->scratch.pose[slot];
-    vec3 c0 = v3_add(x0.p, q_rotate(x0.q, s->local_center[slot]));
-    double reach = shape_bounding_radius(&s->shapes[slot]) + v3_len(s->local_center[slot]);
-    double bound = v3_len(v3_sub(s->center[slot], c0)) + v3_len(step->dq[k]) * reach;
-    return !(bound <= min_extent(&s->shapes[slot])); /* NaN: let the sweep decide */
+    const xform *x0 = &w->scratch.pose[slot];
+    vec3 lc = s->local_center[slot];
+    const shape *sh = &s->shapes[slot];
+    double bound;
+    if (lc.x == 0.0 && lc.y == 0.0 && lc.z == 0.0) {
+        /* the centre of mass at the origin (every primitive): c0 is the
+         * start pose's origin, the same length as make_sweep's dc (a zero
+         * offset turns to zeros; a non-finite start pose makes no sweep) */
+        bound = v3_len(v3_sub(s->center[slot], x0->p)) + v3_len(step->dq[k]) * shape_bounding_radius(sh);
+    } else {
+        vec3 c0 = v3_add(x0->p, q_rotate(x0->q, lc));
+        double reach = shape_bounding_radius(sh) + v3_len(lc);
+        bound = v3_len(v3_sub(s->center[slot], c0)) + v3_len(step->dq[k]) * reach;
+    }
+    return !(bound <= min_extent(sh)); /* NaN: let the sweep decide */
 }
 
 int world_continuous(carom_world *w, const step_context *step)
