@@ -332,18 +332,59 @@ static void sort_order_keys(order_key *a, order_key *tmp, int n)
     }
 }
 
+/* Keys in the order of last step's solve order (the hint), the manifolds
+ * new to it after them in the contact set's order: the merges then mostly
+ * find their halves in order. Without NaN the keys' order is total (ties go
+ * by contact index), so the sorted result does not depend on the order the
+ * keys come in; keys holds them in the contact set's order, tmp receives
+ * them. The hint may be stale (a removed contact's index reused): it only
+ * changes the work. */
+static void order_by_hint(solver_memory *sm, const order_key *keys, order_key *tmp, int n)
+{
+    int *mark = sm->mark, out = 0;
+    for (int k = 0; k < n; k++) mark[keys[k].contact] = k + 1;
+    for (int r = 0; r < sm->last_count; r++) {
+        int c = sm->last_order[r];
+        if (c < sm->mark_capacity && mark[c]) {
+            tmp[out++] = keys[mark[c] - 1];
+            mark[c] = 0;
+        }
+    }
+    for (int k = 0; k < n; k++) {
+        int c = keys[k].contact;
+        if (mark[c]) {
+            tmp[out++] = keys[k];
+            mark[c] = 0;
+        }
+    }
+}
+
+/* Keeps the solve order as next step's hint (0 on out of memory: no hint). */
+static void keep_hint(solver_memory *sm, const int *touching, int n, int contacts)
+{
+    sm->last_count = 0;
+    int had = sm->mark_capacity;
+    if (!array_reserve((void **)&sm->last_order, &sm->last_capacity, n, sizeof *sm->last_order) ||
+        !array_reserve((void **)&sm->mark, &sm->mark_capacity, contacts, sizeof *sm->mark))
+        return;
+    if (sm->mark_capacity > had) memset(sm->mark + had, 0, sizeof *sm->mark * (size_t)(sm->mark_capacity - had));
+    memcpy(sm->last_order, touching, sizeof *touching * (size_t)n);
+    sm->last_count = n;
+}
+
 static int sort_touching(carom_world *w, const step_context *ctx)
 {
     step_scratch *s = &w->scratch;
     solver_memory *sm = &s->solver;
     int n = s->touching_count;
     if (n < 2) return 1;
-    if (!array_reserve(&sm->order, &sm->order_capacity, 2 * n, sizeof(order_key))) return 0; /* keys, then merge space */
+    /* keys, then merge space, then the hinted order */
+    if (!array_reserve(&sm->order, &sm->order_capacity, 3 * n, sizeof(order_key))) return 0;
     order_key *keys = sm->order;
     vec3 up = v3_len2(ctx->gravity) > 0.0 ? v3_normalize(v3_neg(ctx->gravity)) : v3(0, 0, 1);
     vec3 e1, e2;
     v3_basis(up, &e1, &e2);
-    int sorted = 1;
+    int sorted = 1, nan = 0;
     for (int k = 0; k < n; k++) {
         const manifold *m = &w->contacts.data[s->touching[k]].m;
         vec3 c = v3_zero();
@@ -353,11 +394,21 @@ static int sort_touching(carom_world *w, const step_context *ctx)
         keys[k].k[1] = v3_dot(c, e1);
         keys[k].k[2] = v3_dot(c, e2);
         keys[k].contact = s->touching[k];
+        nan |= keys[k].k[0] != keys[k].k[0] || keys[k].k[1] != keys[k].k[1] || keys[k].k[2] != keys[k].k[2];
         if (k > 0 && sorted && by_order_key(&keys[k - 1], &keys[k]) > 0) sorted = 0;
     }
-    if (sorted) return 1;
-    sort_order_keys(keys, keys + n, n);
-    for (int k = 0; k < n; k++) s->touching[k] = keys[k].contact;
+    if (!sorted) {
+        order_key *a = keys;
+        /* NaN makes the order partial, and the result would then depend on the
+         * input order: NaN keys take the contact set's order, as without a hint */
+        if (!nan && sm->last_count > 0 && sm->mark_capacity >= w->contacts.count) {
+            a = keys + 2 * n;
+            order_by_hint(sm, keys, a, n);
+        }
+        sort_order_keys(a, keys + n, n);
+        for (int k = 0; k < n; k++) s->touching[k] = a[k].contact;
+    }
+    keep_hint(sm, s->touching, n, w->contacts.count);
     return 1;
 }
 
@@ -759,6 +810,8 @@ void solver_memory_free(solver_memory *m)
     free(m->block);
     free(m->wide);
     free(m->order);
+    free(m->last_order);
+    free(m->mark);
     memset(m, 0, sizeof *m);
 }
 

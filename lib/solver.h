@@ -13,6 +13,10 @@ typedef struct solver_memory {
     size_t wide_capacity;
     void *order;                 /* the manifolds' solve-order keys (sort_touching) */
     int order_capacity;
+    /* sort_touching's hint: last step's solve order (contact indices) and a
+     * zeroed per-contact mark; only the work of the sort depends on them */
+    int *last_order, *mark;
+    int last_count, last_capacity, mark_capacity;
 } solver_memory;
 void solver_memory_free(solver_memory *m);
 
