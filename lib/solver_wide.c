@@ -275,28 +275,19 @@ LANE_INLINE void gather(const wide_batch *wb, const impulse_body *bodies, lane_b
 LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_bodies *lb)
 {
     /* never the static body 0 (it does not move): a store to it would make the
-     * next batch's gather wait for this batch to finish. Spelled out per lane
-     * (LANES is 4): with a constant lane each element is a register extract,
-     * where the loop went through memory (callgrind: 1.0G of the pile's 19.9G
-     * instructions in the loop) */
-#define SCATTER_LANE(l)                                                          \
-    do {                                                                         \
-        if (wb->a[l]) {                                                          \
-            impulse_body *A_ = &bodies[wb->a[l]];                                \
-            A_->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);                \
-            A_->w = v3(lb->wa[0][l], lb->wa[1][l], lb->wa[2][l]);                \
-        }                                                                        \
-        if (wb->b[l]) {                                                          \
-            impulse_body *B_ = &bodies[wb->b[l]];                                \
-            B_->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);                \
-            B_->w = v3(lb->wb[0][l], lb->wb[1][l], lb->wb[2][l]);                \
-        }                                                                        \
-    } while (0)
-    SCATTER_LANE(0);
-    SCATTER_LANE(1);
-    SCATTER_LANE(2);
-    SCATTER_LANE(3);
-#undef SCATTER_LANE
+     * next batch's gather wait for this batch to finish */
+    for (int l = 0; l < LANES; l++) {
+        if (wb->a[l]) {
+            impulse_body *A = &bodies[wb->a[l]];
+            A->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
+            A->w = v3(lb->wa[0][l], lb->wa[1][l], lb->wa[2][l]);
+        }
+        if (wb->b[l]) {
+            impulse_body *B = &bodies[wb->b[l]];
+            B->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
+            B->w = v3(lb->wb[0][l], lb->wb[1][l], lb->wb[2][l]);
+        }
+    }
 }
 
 LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body *bodies)
