@@ -305,8 +305,12 @@ static int by_order_key(const void *pa, const void *pb)
  * bottom-up merges through tmp, skipping a merge whose halves are already
  * in order (last step's order mostly holds). Inline comparisons instead of
  * qsort's callback: on the 2000-body pile qsort was 2.2G instructions of
- * 20.9G. */
-static void sort_order_keys(order_key *a, order_key *tmp, int n)
+ * 20.9G. trim (keys without NaN, so the order is total and every merge has
+ * one answer): a merge leaves in place the left run's head below the right
+ * run's first key and the right run's tail above the left run's last, found
+ * by bisection, and merges only what lies between (hinted keys: a few out
+ * of place in long runs). */
+static void sort_order_keys(order_key *a, order_key *tmp, int n, int trim)
 {
     enum { RUN = 16 };
     for (int lo = 0; lo < n; lo += RUN) {
@@ -323,11 +327,24 @@ static void sort_order_keys(order_key *a, order_key *tmp, int n)
         for (int lo = 0; lo + width < n; lo += 2 * width) {
             int mid = lo + width, hi = lo + 2 * width < n ? lo + 2 * width : n;
             if (by_order_key(&a[mid - 1], &a[mid]) <= 0) continue; /* already in order */
-            int i = lo, j = mid, k = lo;
-            while (i < mid && j < hi) tmp[k++] = by_order_key(&a[j], &a[i]) < 0 ? a[j++] : a[i++];
+            int first = lo, last = hi;
+            if (trim) {
+                /* first: the left run's first key above a[mid]; last: the right run's first above a[mid - 1] */
+                for (int top = mid; first < top;) {
+                    int m = first + (top - first) / 2;
+                    if (by_order_key(&a[mid], &a[m]) < 0) top = m; else first = m + 1;
+                }
+                last = mid;
+                for (int top = hi; last < top;) {
+                    int m = last + (top - last) / 2;
+                    if (by_order_key(&a[mid - 1], &a[m]) < 0) top = m; else last = m + 1;
+                }
+            }
+            int i = first, j = mid, k = first;
+            while (i < mid && j < last) tmp[k++] = by_order_key(&a[j], &a[i]) < 0 ? a[j++] : a[i++];
             while (i < mid) tmp[k++] = a[i++];
-            while (j < hi) tmp[k++] = a[j++];
-            memcpy(a + lo, tmp + lo, sizeof *a * (size_t)(hi - lo));
+            while (j < last) tmp[k++] = a[j++];
+            memcpy(a + first, tmp + first, sizeof *a * (size_t)(last - first));
         }
     }
 }
@@ -400,12 +417,13 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     if (!sorted) {
         order_key *a = keys;
         /* NaN makes the order partial, and the result would then depend on the
-         * input order: NaN keys take the contact set's order, as without a hint */
+         * input order and the merges' comparisons: NaN keys take the contact
+         * set's order and the full merges, as without a hint */
         if (!nan && sm->last_count > 0 && sm->mark_capacity >= w->contacts.count) {
             a = keys + 2 * n;
             order_by_hint(sm, keys, a, n);
         }
-        sort_order_keys(a, keys + n, n);
+        sort_order_keys(a, keys + n, n, !nan);
         for (int k = 0; k < n; k++) s->touching[k] = a[k].contact;
     }
     keep_hint(sm, s->touching, n, w->contacts.count);
