@@ -224,8 +224,9 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
     return removed;
 }
 
-void world_share_merged_impulses(carom_world *w)
+void world_share_merged_impulses(carom_world *w, const step_context *ctx)
 {
+    (void)ctx;
     const body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
@@ -258,8 +259,9 @@ void world_share_merged_impulses(carom_world *w)
     sc->merged_count = 0;
 }
 
-void world_remove_ghost_contacts(carom_world *w)
+void world_remove_ghost_contacts(carom_world *w, const step_context *ctx)
 {
+    (void)ctx;
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;

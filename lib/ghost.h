@@ -5,9 +5,10 @@
 
 #include "step.h"
 
-void world_remove_ghost_contacts(carom_world *w);
+/* (Every stage takes the step context; these two read only the world.) */
+void world_remove_ghost_contacts(carom_world *w, const step_context *ctx);
 /* After the solve: every manifold merged into another this step takes the
  * merged manifold's solved impulses (warm starting of the next step). */
-void world_share_merged_impulses(carom_world *w);
+void world_share_merged_impulses(carom_world *w, const step_context *ctx);
 
 #endif

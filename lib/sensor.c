@@ -51,8 +51,9 @@ static carom_manifold public_manifold(const manifold *m)
     return out;
 }
 
-void world_pre_solve(carom_world *w)
+void world_pre_solve(carom_world *w, const step_context *ctx)
 {
+    (void)ctx;
     if (!w->pre_solve) return;
     step_scratch *sc = &w->scratch;
     contact_set *cs = &w->contacts;
@@ -122,8 +123,9 @@ static void push_sensor_event(carom_world *w, carom_event_type type, const senso
     events_sensor(w, type, o->sensor, o->other, point);
 }
 
-int world_update_sensors(carom_world *w)
+int world_update_sensors(carom_world *w, const step_context *ctx)
 {
+    (void)ctx;
     body_store *s = &w->bodies;
     sensor_scan q;
     memset(&q, 0, sizeof q);

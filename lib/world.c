@@ -316,8 +316,8 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     int ok = world_update_pairs(w, &ctx);
     double t2 = now_ms();
     if (ok) ok = world_collide(w, &ctx);
-    if (ok) world_remove_ghost_contacts(w);
-    if (ok) world_pre_solve(w);
+    if (ok) world_remove_ghost_contacts(w, &ctx);
+    if (ok) world_pre_solve(w, &ctx);
     double t3 = now_ms();
     if (ok) {
         ok = world_solve(w, &ctx);
@@ -326,13 +326,13 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
             w->locked = 0;
             return CAROM_ERROR_INVALID_ARGUMENT;
         }
-        if (ok) world_share_merged_impulses(w);
+        if (ok) world_share_merged_impulses(w, &ctx);
     }
     double t4 = now_ms();
     if (ok && w->def.enable_continuous) ok = world_continuous(w, &ctx);
     double t5 = now_ms();
     if (ok) world_update_sleep(w, &ctx);
-    if (ok) ok = world_update_sensors(w);
+    if (ok) ok = world_update_sensors(w, &ctx);
     double t6 = now_ms();
 
     w->stats.ms_broadphase = t2 - t1;
