@@ -159,7 +159,7 @@ end
 -- collector is stopped so that finalizers run only at the explicit full
 -- collections below (between calls, and inside contact callbacks, i.e. inside
 -- world:step): an incremental collector's timing depends on memory addresses,
--- and the run must be the same every time. (lua_api_test.lua lets finalizers
+-- and the run must be the same every time. (carom_lua_test.lua lets finalizers
 -- run at arbitrary allocations inside calls.)
 local function hostile_action(w, b)
   local action = R(10)

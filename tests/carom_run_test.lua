@@ -1,4 +1,4 @@
--- runner_test.lua - carom-run from the outside: argument checking and exit
+-- carom_run_test.lua - carom-run (lua/carom-run.c) from the outside: argument checking and exit
 -- statuses, the scene protocol (load, update, contact, report, world, steps,
 -- dt), --steps/--seconds/--dt/--substeps, --record's CSV and --bench's lines.
 -- Runs the very binary that runs this script (arg[-1]), so `make check` tests

@@ -1,8 +1,8 @@
--- lua_api_test.lua - every line of the Lua contract (docs/lua.md, "The
+-- carom_lua_test.lua - every line of the Lua contract (docs/lua.md, "The
 -- contract") and every error path of the bindings. Values are checked against
 -- hand computations (free fall, impulse / mass, inertia of a box ...), never
 -- against what the code printed. Run by `make check` as
--- `carom-run --test tests/lua_api_test.lua`; ends with "N passed, M failed".
+-- `carom-run --test tests/carom_lua_test.lua`; ends with "N passed, M failed".
 local carom = require "carom"
 local T = dofile((arg[0]:match("^(.*[/\\])") or "") .. "harness.lua")
 local test, near, raises = T.test, T.near, T.raises
@@ -437,7 +437,7 @@ test("argument errors name the function and the argument (self is #1)", function
                     { shape = sphere(), mass = -1 })
   local ok, m2 = pcall(function() return world:add_body{ shape = sphere(), mass = -1 } end)
   -- called from Lua code, the message is prefixed with the caller's position, as luaL_argerror does
-  assert(not ok and tostring(m2):sub(-#m1) == m1 and tostring(m2):find("lua_api_test.lua:", 1, true), tostring(m2))
+  assert(not ok and tostring(m2):sub(-#m1) == m1 and tostring(m2):find("carom_lua_test.lua:", 1, true), tostring(m2))
   raises("bad argument #1 to 'sphere' (sphere radius -1 is outside [1e-6, 1e6] m)", carom.sphere, { radius = -1 })
   raises("bad argument #2 to 'step' (dt must be in [1e-6, 1] seconds (got -1))", world.step, world, -1)
   raises("bad argument #1 to 'step' (carom.World expected, got number)", world.step, 5, 1/60)
