@@ -208,6 +208,40 @@ static int touching_impact(const contact_constraint *c, const impulse_body *A, c
     return 0;
 }
 
+/* A manifold's softness, stiffened by the load it carries. A soft contact
+ * of frequency f on the pair's reduced mass m sags W / (m (2 pi f)^2) under
+ * a steady load W, so a column's sag grows with the square of its height
+ * (10 unit boxes at 30 Hz: 2.55 cm; 40: 43 cm) and so does the tilt the
+ * sag allows, which topples tall towers. The spring is tuned to the mass it
+ * holds up: the pair's reduced mass plus the load its last impulses carried
+ * against gravity, m_load = sum(lambda) / (h g), f' = f sqrt(1 + m_load / m),
+ * at most f sqrt(2) (twice the stiffness): with one Gauss-Seidel pass a
+ * stiffer spring rocks a column sideways (cap 2 f: the 10-column at fast
+ * walked 22 cm; no cap: every tower fell). A contact carrying at least its
+ * own pair's weight rests at half the setting's sag; a fresh or unloaded
+ * contact (landing, impact) keeps the setting's softness. Only with relax
+ * passes: without them (fast) the biased pass's push-out speed stays in the
+ * bodies, and the stiffer spring rocked the 10-column 7 cm sideways (2.55 cm
+ * unstiffened). docs/physics.md section 5 has the measurements. */
+#define LOAD_STIFFENING_MAX 1.4142135623730951
+static softness loaded_softness(const step_context *ctx, const impulse_body *A, const impulse_body *B,
+                                const contact_point_state *warm, int count)
+{
+    int fixed = A->inv_mass == 0.0 || B->inv_mass == 0.0;
+    softness base = fixed ? ctx->static_soft : ctx->soft;
+    double inv_m = A->inv_mass + B->inv_mass;
+    if (!(ctx->relax_iterations > 0 && ctx->gravity_length > 0.0 && inv_m > 0.0 && ctx->warm_starting)) return base;
+    double load = 0.0;
+    for (int j = 0; j < count; j++) load += warm[j].normal_impulse;
+    if (!(load > 0.0)) return base;
+    double ratio = load * inv_m / (ctx->h * ctx->gravity_length);
+    double hertz = (fixed ? 2.0 : 1.0) * ctx->contact_hertz;
+    double f = dmin(sqrt(1.0 + ratio), LOAD_STIFFENING_MAX);
+    /* never past a quarter of the sub-step rate, the setting's own cap */
+    double stiff = dmin(hertz * f, dmax(hertz, 0.25 * ctx->inv_h));
+    return make_softness(stiff, ctx->contact_damping_ratio, ctx->h);
+}
+
 /* One header per manifold the collision stage listed as touching: bodies,
  * basis, material, softness; the points stay for prepare_points. */
 static void fill_constraint(carom_world *w, const step_context *ctx, contact_constraint *c, int i)
@@ -232,7 +266,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->friction = cd->friction;
     c->restitution = ctx->restitution ? cd->restitution : 0.0;
     c->rolling = ctx->friction ? cd->rolling_resistance : 0.0;
-    c->soft = (bodies[c->a].inv_mass == 0.0 || bodies[c->b].inv_mass == 0.0) ? ctx->static_soft : ctx->soft;
+    c->soft = loaded_softness(ctx, &bodies[c->a], &bodies[c->b], cd->state, cd->m.count);
     c->wide_batch = -1;
     c->m = &cd->m;
     c->warm = cd->state;

@@ -27,6 +27,7 @@ void step_context_init(step_context *ctx, const carom_world_def *def, double dt)
     ctx->inv_h = 1.0 / ctx->h;
     /* a spring stiffer than a quarter of the sub-step rate is not resolved */
     ctx->contact_hertz = dmin(def->contact_hertz, 0.25 / ctx->h);
+    ctx->contact_damping_ratio = def->contact_damping_ratio;
     ctx->soft = make_softness(ctx->contact_hertz, def->contact_damping_ratio, ctx->h);
     ctx->static_soft = make_softness(2.0 * ctx->contact_hertz, def->contact_damping_ratio, ctx->h);
     ctx->correction = def->position_correction;
@@ -46,5 +47,6 @@ void step_context_init(step_context *ctx, const carom_world_def *def, double dt)
     ctx->penalty_stiffness = def->penalty_stiffness;
     ctx->penalty_damping = def->penalty_damping;
     ctx->gravity = v3(def->gravity.x, def->gravity.y, def->gravity.z);
+    ctx->gravity_length = v3_len(ctx->gravity);
     ctx->tasks = def;
 }

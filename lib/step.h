@@ -27,6 +27,7 @@ typedef struct step_context {
     double h, inv_h;             /* sub-step and its inverse */
     /* contacts */
     double contact_hertz;        /* the setting, capped at a quarter of the sub-step rate */
+    double contact_damping_ratio; /* the setting (solver.c stiffens loaded contacts) */
     softness soft;               /* between two moving bodies */
     softness static_soft;        /* against a static or kinematic body: twice as stiff */
     carom_position_correction correction;
@@ -41,6 +42,7 @@ typedef struct step_context {
     int penalty_implicit;
     double penalty_stiffness, penalty_damping;
     vec3 gravity;
+    double gravity_length;       /* |gravity| */
     const carom_world_def *tasks; /* the world's task hooks (tasks.h) */
     /* solver bodies (the solver's gather stage): index 0 is the shared
      * immovable body */

@@ -285,6 +285,73 @@ static void test_column_creation_order(void **state)
     }
 }
 
+/* Soft contacts stiffened by their load (solver.c, loaded_softness): a
+ * contact carrying at least its pair's weight (every contact of a column)
+ * springs at f' = min(sqrt(2) f, max(f, 1/(4h))), f = contact_hertz between
+ * two moving boxes and 2 contact_hertz against the ground; with relax passes
+ * only (fast: f). A column of n boxes of mass m then rests
+ * with its top lowered by the static deflections: the contact under k boxes
+ * carries k m g on four corners of normal mass m/8 (box on box: 1/m + 3/m
+ * per body) or m/4 (on the ground), so it sags 2 k g / omega'^2 (box on box)
+ * or k g / omega'^2 (ground). Checked against that sum at every preset, for
+ * columns of 2, 10 and 20 (the ones that stand: 10 at fast, 20 at accurate), box half sizes 0.25 and 1 m, masses 1 and 10 kg,
+ * dt 1/60 to 1/240, at the origin and 1e5 m from it. Without the stiffening
+ * the 10-column sags 2.55 cm at default (1.31 cm with it). */
+static double stiffened_hertz(double f, double h, int relax)
+{
+    if (!relax) return f;
+    return fmin(sqrt(2.0) * f, fmax(f, 0.25 / h));
+}
+
+static void test_column_sag_loaded_softness(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const int sizes[] = {2, 10, 20};
+    const double dts[] = {1.0 / 60, 1.0 / 120, 1.0 / 240};
+    const double halves[] = {0.5, 0.25, 1.0};
+    const double masses[] = {1.0, 10.0};
+    int v = 0, bad = 0;
+    for (int p = 0; p < 3; p++)
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 3; d++, v++) {
+                /* not standing, so no sag to check (issue #16, measured): the 20-tower
+                 * falls at fast and leans 0.45 m at default; at fast a 2-box stack
+                 * of 0.5 m half size walks 3.6 cm sideways at dt 1/60 */
+                if (sizes[k] == 20 && p < 2) continue;
+                if (sizes[k] == 2 && p == 0) continue;
+                carom_world_def wd = preset_def(presets[p]);
+                wd.enable_sleep = 0;
+                double half = halves[v % 3], mass = masses[v % 2], far = (v % 2) ? 1e5 : 0.0;
+                int n = sizes[k];
+                carom_world *w = carom_world_create(&wd);
+                assert_non_null(w);
+                carom_body_def g = carom_body_def_default();
+                g.type = CAROM_BODY_STATIC;
+                g.shape = carom_shape_box(50, 50, 0.5);
+                g.position = vec(far, far, -0.5);
+                g.friction = 0.6;
+                add_body(w, &g);
+                carom_body_id top = carom_null_body();
+                for (int i = 0; i < n; i++) top = add_box(w, far, far, half + 2 * half * i, half, mass, 0.6);
+                double dt = dts[d];
+                step_n(w, (int)(10.0 / dt + 0.5), dt);
+                double h = dt / wd.substeps;
+                double f = fmin(wd.contact_hertz, 0.25 / h);
+                double wd_ = 2 * PI_ * stiffened_hertz(f, h, wd.relax_iterations > 0);
+                double ws_ = 2 * PI_ * stiffened_hertz(2 * f, h, wd.relax_iterations > 0);
+                double sag = n * G / (ws_ * ws_);
+                for (int j = 1; j < n; j++) sag += 2.0 * j * G / (wd_ * wd_);
+                carom_vec3 q = pos(w, top);
+                double dz = q.z - (half + 2 * half * (n - 1)), dx = hypot(q.x - far, q.y - far);
+                print_message("%s n %d dt 1/%.0f half %g m %g at %g: sag %.6f (analytic %.6f), sideways %.6f\n",
+                              presets[p], n, 1 / dt, half, mass, far, -dz, sag, dx);
+                if (!(fabs(-dz - sag) <= 0.05 * sag)) { print_error("column sag off by more than 5 %%\n"); bad++; }
+                carom_world_destroy(w);
+            }
+    assert_int_equal(bad, 0);
+}
+
 static void test_pyramid_stands(void **state)
 {
     (void)state;
@@ -986,6 +1053,7 @@ int main(void)
         cmocka_unit_test(test_stack_of_ten),
         cmocka_unit_test(test_linear_slop_every_mode),
         cmocka_unit_test(test_column_creation_order),
+        cmocka_unit_test(test_column_sag_loaded_softness),
         cmocka_unit_test(test_pyramid_stands),
         cmocka_unit_test(test_mass_ratio_holds),
         cmocka_unit_test(test_locks),
