@@ -51,6 +51,36 @@ static int by_dynamic(const void *x, const void *y)
     return a->contact < b->contact ? -1 : (a->contact > b->contact);
 }
 
+/* Sorts n entries by by_dynamic (a total order: the contacts differ), so
+ * the result is the one qsort gave: runs of 16 by insertion, then bottom-up
+ * merges through tmp. Inline comparisons instead of qsort's callback (62M
+ * instructions on the 2000-body pile, callgrind). */
+static void sort_entries(ghost_entry *a, ghost_entry *tmp, int n)
+{
+    enum { RUN = 16 };
+    for (int lo = 0; lo < n; lo += RUN) {
+        int hi = lo + RUN < n ? lo + RUN : n;
+        for (int i = lo + 1; i < hi; i++) {
+            if (by_dynamic(&a[i - 1], &a[i]) <= 0) continue;
+            ghost_entry x = a[i];
+            int j = i;
+            while (j > lo && by_dynamic(&a[j - 1], &x) > 0) { a[j] = a[j - 1]; j--; }
+            a[j] = x;
+        }
+    }
+    for (int width = RUN; width < n; width *= 2) {
+        for (int lo = 0; lo + width < n; lo += 2 * width) {
+            int mid = lo + width, hi = lo + 2 * width < n ? lo + 2 * width : n;
+            if (by_dynamic(&a[mid - 1], &a[mid]) <= 0) continue; /* already in order */
+            int i = lo, j = mid, k = lo;
+            while (i < mid && j < hi) tmp[k++] = by_dynamic(&a[j], &a[i]) < 0 ? a[j++] : a[i++];
+            while (i < mid) tmp[k++] = a[i++];
+            while (j < hi) tmp[k++] = a[j++];
+            memcpy(a + lo, tmp + lo, sizeof *a * (size_t)(hi - lo));
+        }
+    }
+}
+
 /* How far the shape reaches along unit direction n: max over it of
  * dot(n, x), over the part of a mesh or height field within `near` (world
  * bounds around the dynamic body: a hill elsewhere on the same mesh does
@@ -270,7 +300,7 @@ void world_remove_ghost_contacts(carom_world *w, const step_context *ctx)
      * body and a static or kinematic one (step_scratch.mixed) */
     int n = sc->mixed_count;
     if (n < 2) return;
-    ghost_entry *e = malloc(sizeof *e * (size_t)n);
+    ghost_entry *e = malloc(sizeof *e * 2 * (size_t)n); /* the entries, then sort_entries' merge space */
     if (!e) return; /* out of memory: the ghosts stay, as they would without this pass */
     n = 0;
     for (int m = 0; m < sc->mixed_count; m++) {
@@ -283,7 +313,7 @@ void world_remove_ghost_contacts(carom_world *w, const step_context *ctx)
         ghost_entry g = {da ? c->id_a : c->id_b, da ? c->id_b : c->id_a, ci, k, normal};
         e[n++] = g;
     }
-    qsort(e, (size_t)n, sizeof *e, by_dynamic);
+    sort_entries(e, e + n, n);
     double tol = GHOST_STEP;
     int removed = 0;
     for (int first = 0; first < n;) {
