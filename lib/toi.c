@@ -25,6 +25,9 @@
 #include <string.h>
 #include "filter.h"
 #include "compound.h"
+#include "gjk.h"
+#include "mesh.h"
+#include "heightfield.h"
 #include "world.h"
 #include "toi.h"
 
@@ -33,6 +36,9 @@
  * (the contact solve removes that overlap; linear_slop's default once) */
 #define TOI_SINK 0.005
 #define TOI_MAX_PASSES 32
+/* farther apart than this, a pair's separation is its distance (GJK's
+ * proven lower bound); nearer, the contacts the next step will see */
+#define TOI_NEAR 0.01
 
 /* Thickness below which a shape can pass through others in one step. */
 static double min_extent(const shape *s)
@@ -119,14 +125,136 @@ static xform pose_at(const carom_world *w, const sweep *sw, double f, int slot, 
     return x;
 }
 
+/* ---- separation far from contact: distance only ------------------------------
+ * Conservative advancement needs only a lower bound of the distance and the
+ * direction it holds along while the pair is apart; building contact
+ * manifolds for it (every triangle of a mesh within the step's reach, each
+ * clipped and grouped) cost the terrain most of its continuous collision.
+ * Farther than TOI_NEAR, GJK's proven lower bound and its separating plane's
+ * normal serve (for a mesh or height field: the least over the triangles,
+ * each first bounded by its plane); nearer, or overlapping, the full contact
+ * collision decides as before, so where a body stops is judged by the same
+ * contacts the solver will see. */
+
+typedef struct far_query {
+    const shape *s;       /* the convex shape, at xs */
+    xform xs, xm;         /* and the mesh's frame */
+    int two_sided;
+    double best;          /* least lower bound so far (starts at the range) */
+    vec3 normal;          /* its normal, from the triangle to the shape */
+    int near;             /* 1: a triangle within TOI_NEAR: the full collision decides */
+} far_query;
+
+static int far_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t index)
+{
+    far_query *q = ctx;
+    (void)active;
+    (void)index;
+    /* positions relative to the shape (precision far from the origin) */
+    vec3 t[3];
+    for (int k = 0; k < 3; k++) t[k] = v3_sub(xf_point(q->xm, v[k]), q->xs.p);
+    vec3 n = v3_cross(v3_sub(t[1], t[0]), v3_sub(t[2], t[0]));
+    double len = v3_len(n);
+    if (!(len > 0) || !isfinite(len)) return 1; /* degenerate: no contact either */
+    n = v3_scale(n, 1.0 / len);
+    /* the shape's extent along the face normal bounds its distance from the triangle */
+    vec3 lo = q_rotate(q->xs.q, shape_support_local(q->s, q_inv_rotate(q->xs.q, v3_neg(n))));
+    vec3 hi = q_rotate(q->xs.q, shape_support_local(q->s, q_inv_rotate(q->xs.q, n)));
+    double below = v3_dot(n, v3_sub(lo, t[0])), above = v3_dot(n, v3_sub(hi, t[0]));
+    if (!q->two_sided && above < 0) return 1; /* wholly behind a one-sided face: it never collides */
+    double bound = q->two_sided ? dmax(below, -above) : below;
+    if (bound >= q->best) return 1;
+    gjk_proxy pt = {NULL, t, 3, {v3_zero(), q_identity()}};
+    gjk_proxy ps = {q->s, NULL, 0, {v3_zero(), q->xs.q}};
+    gjk_result r = gjk_distance(&pt, &ps);
+    if (r.overlap || !(r.lower_bound > TOI_NEAR)) { q->near = 1; return 0; }
+    if (r.lower_bound < q->best) { q->best = r.lower_bound; q->normal = r.lower_normal; }
+    return 1;
+}
+
+/* Radius of a ball about the shape's origin inside it (0 when not known). */
+static double inner_radius(const shape *s)
+{
+    switch (s->type) {
+    case SHAPE_SPHERE: case SHAPE_CAPSULE: case SHAPE_BOX: case SHAPE_CYLINDER: return min_extent(s);
+    default: return 0.0;
+    }
+}
+
+static xform xf_mul(xform a, xform b)
+{
+    xform r = {xf_point(a, b.p), q_mul(a.q, b.q)};
+    return r;
+}
+
+/* (toi.h) */
+int toi_far_separation(const shape *a, xform xa, const shape *b, xform xb, double range, double *d, vec3 *normal)
+{
+    if (a->type == SHAPE_PLANE || b->type == SHAPE_PLANE) return 0;
+    if (a->type == SHAPE_COMPOUND || b->type == SHAPE_COMPOUND) { /* the nearest child */
+        int on_a = a->type == SHAPE_COMPOUND;
+        const compound *c = on_a ? a->compound : b->compound;
+        double best = range;
+        vec3 bn = v3(0, 0, 1);
+        for (int i = 0; i < c->count; i++) {
+            double di;
+            vec3 ni;
+            int ok = on_a ? toi_far_separation(&c->children[i], xf_mul(xa, c->poses[i]), b, xb, best, &di, &ni)
+                          : toi_far_separation(a, xa, &c->children[i], xf_mul(xb, c->poses[i]), best, &di, &ni);
+            if (!ok) return 0;
+            if (di < best) { best = di; bn = ni; }
+        }
+        *d = best;
+        *normal = bn;
+        return 1;
+    }
+    if (shape_is_composite(a) || shape_is_composite(b)) {
+        if (shape_is_composite(a) && shape_is_composite(b)) return 0;
+        int mesh_first = shape_is_composite(a);
+        const shape *ms = mesh_first ? a : b, *cs = mesh_first ? b : a;
+        far_query q;
+        q.s = cs;
+        q.xs = mesh_first ? xb : xa;
+        q.xm = mesh_first ? xa : xb;
+        q.two_sided = ms->type == SHAPE_MESH && ms->mesh->two_sided;
+        q.best = range;
+        q.normal = v3(0, 0, 1);
+        q.near = 0;
+        xform rel = {xf_inv_point(q.xm, q.xs.p), q_mul(q_conj(q.xm.q), q.xs.q)};
+        aabb box = aabb_fatten(shape_aabb(cs, rel), range);
+        if (ms->type == SHAPE_MESH) mesh_query(ms->mesh, box, far_triangle, &q);
+        else heightfield_query(ms->field, box, far_triangle, &q);
+        if (q.near) return 0;
+        *d = q.best;
+        *normal = mesh_first ? q.normal : v3_neg(q.normal);
+        return 1;
+    }
+    /* a ball inside each (about its origin) bounds the distance from above:
+     * a pair resting on each other is near without asking GJK */
+    double ia = inner_radius(a), ib = inner_radius(b);
+    if (v3_len(v3_sub(xb.p, xa.p)) - ia - ib <= TOI_NEAR) return 0;
+    gjk_proxy pa = {a, NULL, 0, {v3_zero(), xa.q}};
+    gjk_proxy pb = {b, NULL, 0, {v3_sub(xb.p, xa.p), xb.q}};
+    gjk_result r = gjk_distance(&pa, &pb);
+    if (r.overlap || !(r.lower_bound > TOI_NEAR)) return 0;
+    *d = dmin(r.lower_bound, range);
+    *normal = r.lower_normal;
+    return 1;
+}
+
 /* Separation of bodies a and b at time t (large when beyond range), and the
  * contact normal from a to b. */
-static double separation_at(const toi_context *ctx, int a, int b, double t, double range, vec3 *normal)
+static double separation_at(const toi_context *ctx, int a, int b, double t, double range, int *try_far, vec3 *normal)
 {
     const carom_world *w = ctx->w;
     const body_store *s = &w->bodies;
     xform xa = pose_at(w, &ctx->sweeps[a], ctx->fraction[a], a, t);
     xform xb = pose_at(w, &ctx->sweeps[b], ctx->fraction[b], b, t);
+    double far;
+    if (*try_far) {
+        if (toi_far_separation(&s->shapes[a], xa, &s->shapes[b], xb, range, &far, normal)) return far;
+        *try_far = 0; /* within TOI_NEAR: the advancement only closes in from here */
+    }
     collide_cache cache;
     memset(&cache, 0, sizeof cache);
     cache.feature = -1;
@@ -150,7 +278,8 @@ static double pair_toi(const toi_context *ctx, int a, int b, double limit)
     double range = la + lb + ra + rb + ctx->target;
     if (!(range > ctx->target) || !isfinite(range)) return limit;
     vec3 n;
-    double d0 = separation_at(ctx, a, b, 0.0, range, &n);
+    int try_far = 1;
+    double d0 = separation_at(ctx, a, b, 0.0, range, &try_far, &n);
     /* already touching: may sink a little deeper, no more */
     double tolerance = 0.25 * ctx->target;
     double stop = d0 > ctx->target + tolerance ? ctx->target : d0 - ctx->slop + tolerance;
@@ -172,7 +301,7 @@ static double pair_toi(const toi_context *ctx, int a, int b, double limit)
         } else {
             t += step;
         }
-        d = separation_at(ctx, a, b, t, range, &n);
+        d = separation_at(ctx, a, b, t, range, &try_far, &n);
     }
     return t; /* not converged: stop where the advancement got (never past contact) */
 }

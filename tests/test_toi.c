@@ -14,6 +14,9 @@
 #include <cmocka.h>
 #include "carom/carom.h"
 #include "world.h"
+#include "toi.h"
+#include "mesh.h"
+#include "heightfield.h"
 
 #include "helpers.h"
 
@@ -332,6 +335,179 @@ static void test_issue17_finding6_struck_resting_body_stays_out(void **state)
                     }
 }
 
+/* ---- the distance-only separation far from contact (toi_far_separation) ----
+ * Against an independent brute force: every triangle of a wavy mesh and a
+ * height field sampled on a barycentric grid, each sample's exact distance
+ * to the convex shape (closed forms per type, in the shape's frame). The
+ * least sampled distance is at least the true distance and at most h more
+ * (h: the farthest any triangle point is from its nearest sample; distance
+ * is 1-Lipschitz). The bound must never exceed the true distance, must be
+ * within h + 1e-6 of it, and must say "near" (0) only within TOI_NEAR + h.
+ * Also a sphere against each convex type (exact: the centre's distance
+ * minus the radius), and a compound of two of them. */
+
+#define FAR_SUB 48
+
+static double point_shape_distance(const shape *s, xform x, vec3 pw)
+{
+    vec3 p = xf_inv_point(x, pw);
+    switch (s->type) {
+    case SHAPE_SPHERE: return v3_len(p) - s->radius;
+    case SHAPE_BOX: {
+        vec3 q = v3(fabs(p.x) - s->half_extents.x, fabs(p.y) - s->half_extents.y, fabs(p.z) - s->half_extents.z);
+        vec3 o = v3(dmax(q.x, 0), dmax(q.y, 0), dmax(q.z, 0));
+        return v3_len(o) > 0 ? v3_len(o) : dmax(q.x, dmax(q.y, q.z));
+    }
+    case SHAPE_CAPSULE: {
+        double z = dmax(-s->half_height, dmin(s->half_height, p.z));
+        return v3_len(v3(p.x, p.y, p.z - z)) - s->radius;
+    }
+    case SHAPE_CYLINDER: {
+        double dr = sqrt(p.x * p.x + p.y * p.y) - s->radius, dz = fabs(p.z) - s->half_height;
+        double ox = dmax(dr, 0), oz = dmax(dz, 0);
+        return ox > 0 || oz > 0 ? sqrt(ox * ox + oz * oz) : dmax(dr, dz);
+    }
+    default: fail(); return 0;
+    }
+}
+
+typedef struct far_brute { const shape *s; xform xs, xm; double best, h; } far_brute;
+
+static int far_brute_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t index)
+{
+    (void)active;
+    (void)index;
+    far_brute *b = ctx;
+    vec3 w[3] = {xf_point(b->xm, v[0]), xf_point(b->xm, v[1]), xf_point(b->xm, v[2])};
+    double longest = dmax(v3_len(v3_sub(w[1], w[0])), dmax(v3_len(v3_sub(w[2], w[1])), v3_len(v3_sub(w[0], w[2]))));
+    b->h = dmax(b->h, longest / FAR_SUB);
+    for (int i = 0; i <= FAR_SUB; i++)
+        for (int j = 0; i + j <= FAR_SUB; j++) {
+            double u = (double)i / FAR_SUB, t = (double)j / FAR_SUB;
+            vec3 p = v3_add(v3_scale(w[0], 1 - u - t), v3_add(v3_scale(w[1], u), v3_scale(w[2], t)));
+            b->best = dmin(b->best, point_shape_distance(b->s, b->xs, p));
+        }
+    return 1;
+}
+
+static void check_far(const char *what, const shape *a, xform xa, const shape *b, xform xb, double truth, double h,
+                      int *far_count)
+{
+    double d = -1;
+    vec3 n = v3_zero();
+    int far = toi_far_separation(a, xa, b, xb, 10.0, &d, &n);
+    if (far) {
+        (*far_count)++;
+        if (!(d <= truth + 1e-9 && d >= truth - h - 1e-6 && fabs(v3_len(n) - 1) < 1e-9)) {
+            print_error("%s: bound %.9f against brute force %.9f (h %.4f)\n", what, d, truth, h);
+            fail();
+        }
+    } else if (truth > 0.01 + h + 1e-6) {
+        print_error("%s: said near at brute-force distance %.6f\n", what, truth);
+        fail();
+    }
+}
+
+static void test_far_separation_against_brute_force(void **state)
+{
+    (void)state;
+    /* a wavy 6 x 6 grid of 0.25 m cells, as a one-sided mesh and as a height field */
+    enum { N = 6 };
+    double v[(N + 1) * (N + 1) * 3], heights[(N + 1) * (N + 1)];
+    int t[N * N * 6];
+    for (int j = 0; j <= N; j++)
+        for (int i = 0; i <= N; i++) {
+            double x = (i - 0.5 * N) * 0.25, y = (j - 0.5 * N) * 0.25, z = 0.2 * sin(2.1 * x) * cos(1.7 * y);
+            int k = j * (N + 1) + i;
+            v[3 * k] = x; v[3 * k + 1] = y; v[3 * k + 2] = z;
+            heights[k] = z;
+        }
+    for (int j = 0, q = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            int a = j * (N + 1) + i, b = a + 1, c = a + N + 1, d = c + 1;
+            t[q++] = a; t[q++] = b; t[q++] = d;
+            t[q++] = a; t[q++] = d; t[q++] = c;
+        }
+    char err[128];
+    shape level[2];
+    memset(level, 0, sizeof level);
+    level[0].type = SHAPE_MESH;
+    level[0].mesh = mesh_build(v, (N + 1) * (N + 1), t, 2 * N * N, 0, err, (int)sizeof err);
+    level[1].type = SHAPE_HEIGHTFIELD;
+    level[1].field = heightfield_build(heights, N + 1, N + 1, 0.25, 0.25, NULL, 0, err, (int)sizeof err);
+    assert_non_null(level[0].mesh);
+    assert_non_null(level[1].field);
+    shape convex[4];
+    memset(convex, 0, sizeof convex);
+    convex[0].type = SHAPE_SPHERE; convex[0].radius = 0.15;
+    convex[1].type = SHAPE_BOX; convex[1].half_extents = v3(0.2, 0.1, 0.15);
+    convex[2].type = SHAPE_CAPSULE; convex[2].radius = 0.08; convex[2].half_height = 0.2;
+    convex[3].type = SHAPE_CYLINDER; convex[3].radius = 0.18; convex[3].half_height = 0.1;
+    uint64_t seed = 0x70F4A25EEDull;
+    int far_count = 0, cases = 0;
+    for (int l = 0; l < 2; l++)
+        for (int c = 0; c < 4; c++)
+            for (int k = 0; k < 24; k++) {
+                /* the level placed far from the origin and turned; the shape above it */
+                xform xm = {v3(1000.0 + k, -2000.0, 50.0), q_normalize(q_axis_angle(v3(0.3, -0.2, 1), 0.4 * k))};
+                double lift = 0.003 + 0.6 * rnd(&seed) * rnd(&seed);
+                vec3 local = v3(0.9 * (rnd(&seed) - 0.5), 0.9 * (rnd(&seed) - 0.5), 0.3 + lift);
+                quat q = q_normalize(q_axis_angle(v3(rnd(&seed) - 0.5, rnd(&seed) - 0.5, rnd(&seed) - 0.5), 6.3 * rnd(&seed)));
+                xform xs = {xf_point(xm, local), q_mul(xm.q, q)};
+                far_brute bf = {&convex[c], xs, xm, 1e300, 0};
+                aabb all = {v3(-10, -10, -10), v3(10, 10, 10)};
+                if (l == 0) mesh_query(level[0].mesh, all, far_brute_triangle, &bf);
+                else heightfield_query(level[1].field, all, far_brute_triangle, &bf);
+                if (bf.best <= 0) continue; /* overlapping: the full collision's */
+                char what[64];
+                snprintf(what, sizeof what, "%s type %d case %d", l ? "field" : "mesh", c, k);
+                check_far(what, &level[l], xm, &convex[c], xs, bf.best, bf.h, &far_count);
+                /* either order: the normal turns, the bound does not */
+                check_far(what, &convex[c], xs, &level[l], xm, bf.best, bf.h, &far_count);
+                cases++;
+            }
+    /* a sphere against each convex type, and a compound of a box and a cylinder */
+    for (int c = 0; c < 4; c++)
+        for (int k = 0; k < 50; k++) {
+            xform xb = {v3(-300.0, 40.0, 7.0), q_normalize(q_axis_angle(v3(rnd(&seed), rnd(&seed), 1), 6.3 * rnd(&seed)))};
+            vec3 dir = v3_normalize(v3(rnd(&seed) - 0.5, rnd(&seed) - 0.5, rnd(&seed) - 0.5));
+            xform xa = {v3_madd(xb.p, 0.2 + 0.5 * rnd(&seed), dir), q_identity()};
+            double truth = point_shape_distance(&convex[c], xb, xa.p) - convex[0].radius;
+            if (truth <= 0) continue;
+            check_far("sphere pair", &convex[0], xa, &convex[c], xb, truth, 0.0, &far_count);
+            cases++;
+        }
+    shape comp;
+    memset(&comp, 0, sizeof comp);
+    comp.type = SHAPE_COMPOUND;
+    comp.compound = compound_alloc(2);
+    assert_non_null(comp.compound);
+    comp.compound->count = 2;
+    comp.compound->children[0] = convex[1];
+    comp.compound->children[1] = convex[3];
+    comp.compound->poses[0] = (xform){v3(0.3, 0, 0), q_identity()};
+    comp.compound->poses[1] = (xform){v3(-0.3, 0.1, 0), q_axis_angle(v3(1, 0, 0), 1.0)};
+    for (int k = 0; k < 50; k++) {
+        xform xb = {v3(5.0, 5.0, 5.0), q_normalize(q_axis_angle(v3(rnd(&seed), 1, rnd(&seed)), 6.3 * rnd(&seed)))};
+        vec3 dir = v3_normalize(v3(rnd(&seed) - 0.5, rnd(&seed) - 0.5, rnd(&seed) - 0.5));
+        xform xa = {v3_madd(xb.p, 0.3 + 0.6 * rnd(&seed), dir), q_identity()};
+        double truth = 1e300;
+        for (int i = 0; i < 2; i++) {
+            xform xc = {xf_point(xb, comp.compound->poses[i].p), q_mul(xb.q, comp.compound->poses[i].q)};
+            truth = dmin(truth, point_shape_distance(&comp.compound->children[i], xc, xa.p) - convex[0].radius);
+        }
+        if (truth <= 0) continue;
+        check_far("sphere-compound", &convex[0], xa, &comp, xb, truth, 0.0, &far_count);
+        cases++;
+    }
+    /* the far path answered most of them (the rest lie within TOI_NEAR) */
+    print_message("far separation: %d of %d answered far\n", far_count, 2 * cases);
+    assert_true(far_count > cases);
+    shape_free_data(&comp);
+    mesh_free(level[0].mesh);
+    heightfield_free(level[1].field);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -342,6 +518,7 @@ int main(void)
         cmocka_unit_test(test_fast_dynamic_bodies_meet),
         cmocka_unit_test(test_kinematic_rotation_is_exact),
         cmocka_unit_test(test_issue17_finding6_struck_resting_body_stays_out),
+        cmocka_unit_test(test_far_separation_against_brute_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
