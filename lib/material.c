@@ -83,19 +83,27 @@ static surface body_surface(const body_store *s, int slot, int child)
     return f;
 }
 
+void material_mix(const body_store *s, int sa, int sb, uint32_t sub, double out[3])
+{
+    int ca = -1, cb = -1;
+    compound_sub_children(&s->shapes[sa], &s->shapes[sb], sub, &ca, &cb);
+    surface fa = body_surface(s, sa, ca), fb = body_surface(s, sb, cb);
+    int mode = fa.combine > fb.combine ? fa.combine : fb.combine; /* the higher mode wins */
+    out[0] = combine_values(mode, 0, fa.friction, fb.friction);
+    out[1] = combine_values(mode, 1, fa.restitution, fb.restitution);
+    out[2] = combine_values(mode, 2, fa.rolling_resistance, fb.rolling_resistance);
+}
+
 void material_mix_contact(carom_world *w, int contact_index)
 {
     const body_store *s = &w->bodies;
     const contact *c = &w->contacts.items[contact_index];
     contact_data *d = &w->contacts.data[contact_index];
-    int sa = s->ids[c->id_a].slot, sb = s->ids[c->id_b].slot;
-    int ca = -1, cb = -1;
-    compound_sub_children(&s->shapes[sa], &s->shapes[sb], c->sub, &ca, &cb);
-    surface fa = body_surface(s, sa, ca), fb = body_surface(s, sb, cb);
-    int mode = fa.combine > fb.combine ? fa.combine : fb.combine; /* the higher mode wins */
-    d->friction = combine_values(mode, 0, fa.friction, fb.friction);
-    d->restitution = combine_values(mode, 1, fa.restitution, fb.restitution);
-    d->rolling_resistance = combine_values(mode, 2, fa.rolling_resistance, fb.rolling_resistance);
+    double m[3];
+    material_mix(s, s->ids[c->id_a].slot, s->ids[c->id_b].slot, c->sub, m);
+    d->friction = m[0];
+    d->restitution = m[1];
+    d->rolling_resistance = m[2];
 }
 
 CAROM_API carom_status carom_body_set_material(carom_world *w, carom_body_id id, const carom_material *material)

@@ -11,6 +11,9 @@ int material_valid(const carom_material *m, char *msg, size_t msg_size);
 /* A valid material's values into the four outputs. */
 void material_apply(const carom_material *m, double *friction, double *restitution, double *rolling_resistance,
                     int *combine);
+/* The friction, restitution and rolling resistance a contact of manifold
+ * number sub between the bodies in slots sa and sb mixes to (into out). */
+void material_mix(const body_store *s, int sa, int sb, uint32_t sub, double out[3]);
 /* The contact's friction, restitution and rolling resistance from its two
  * bodies (or compound children), by their combine modes. */
 void material_mix_contact(carom_world *w, int contact_index);

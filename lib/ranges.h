@@ -14,6 +14,15 @@
 #define CAROM_RANGES_H
 
 #define RANGE_COORDINATE_MAX 1e12   /* m: |position component|, |plane offset| */
+/* m: |coordinate| of a body's pose in a world's state (the snapshot reader's
+ * bound). The calls refuse a position beyond 1e12, but a step does not stop
+ * a body there: one at the edge moves on, at most 1e9 m/s x 1 s a step (a
+ * fuzzed body at 1e12 m fell past it and its snapshot was refused). At 1e18
+ * (a million steps at the speed ceiling beyond 1e15) squares and products of
+ * three coordinates stay below 1e54; the snapshot fuzz harness steps every
+ * accepted world and checks it stays finite. A plane-locked body's plane
+ * offset n.c has the same bound. */
+#define RANGE_STATE_COORDINATE_MAX 1e18
 #define RANGE_LENGTH_MIN 1e-6       /* m: radius, half extent, half height */
 #define RANGE_LENGTH_MAX 1e6        /* m: the same, and |hull point component| */
 #define RANGE_MASS_MIN 1e-9         /* kg: a dynamic body's mass, given or from density */

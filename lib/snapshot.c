@@ -22,9 +22,10 @@
 #include "mesh.h"
 #include "heightfield.h"
 #include "compound.h"
+#include "material.h"
 
 #define SNAP_MAGIC "CAROMSNP"
-#define SNAP_VERSION 4u
+#define SNAP_VERSION 5u
 #define SNAP_HEADER_SIZE 32u
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
@@ -1063,16 +1064,15 @@ static int normal_is_state(const contact *c, const contact_data *d)
 /* What the reader predicts from the two bodies, before the contact's numbers. */
 typedef struct contact_guess {
     xform xa, xb;
-    double friction, restitution;
+    double material[3]; /* friction, restitution, rolling resistance as material.c mixes them */
 } contact_guess;
 
-static contact_guess guess_contact(const body_store *s, const xform *pose, int a, int b)
+static contact_guess guess_contact(const body_store *s, const xform *pose, int a, int b, uint32_t sub)
 {
     contact_guess g;
     g.xa = pose[a];
     g.xb = pose[b];
-    g.friction = sqrt(s->friction[a] * s->friction[b]);
-    g.restitution = dmax(s->restitution[a], s->restitution[b]);
+    material_mix(s, a, b, sub, g.material);
     return g;
 }
 
@@ -1086,8 +1086,8 @@ static unsigned contact_bits(const contact *c, const contact_data *d, const cont
                         (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
                         (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
                         (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
-                        (f64_bits(d->friction) == f64_bits(g.friction) && f64_bits(d->restitution) == f64_bits(g.restitution) &&
-                                    f64_bits(d->rolling_resistance) == 0
+                        (f64_bits(d->friction) == f64_bits(g.material[0]) && f64_bits(d->restitution) == f64_bits(g.material[1]) &&
+                                    f64_bits(d->rolling_resistance) == f64_bits(g.material[2])
                              ? 0 : CREC_MATERIAL) |
                         (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
                              ? CREC_POSE : 0) |
@@ -1105,7 +1105,7 @@ static void write_contacts(writer *o, const carom_world *w)
         const contact *c = &cs->items[i];
         const contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        contact_guess g = guess_contact(s, s->collided, a, b);
+        contact_guess g = guess_contact(s, s->collided, a, b, c->sub);
         /* what the reader will hold, and predict from */
         vec3 normal = normal_is_state(c, d) ? d->m.normal : v3(0, 0, 0);
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
@@ -1137,8 +1137,8 @@ static void write_contacts(writer *o, const carom_world *w)
         if (bits & CREC_NORMAL) put_coded_v3(o, normal, v3(0, 0, 0));
         if (bits & CREC_CACHE_NORMAL) put_coded_v3(o, c->cache.normal, cache_guess);
         if (bits & CREC_MATERIAL) {
-            double v[3] = {d->friction, d->restitution, d->rolling_resistance}, p[3] = {g.friction, g.restitution, 0};
-            put_coded(o, v, p, 3);
+            double v[3] = {d->friction, d->restitution, d->rolling_resistance};
+            put_coded(o, v, g.material, 3);
         }
         if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, basis_guess(c->cache.normal));
         /* only what the collision stage reads under each flag (collision.c):
@@ -1473,8 +1473,7 @@ static int read_bodies(reader *r, carom_world *w)
         s->sleep_time[i] = (bits & REC_SLEEP_TIME) ? (last_sleep = get_coded1(r, last_sleep, what)) : 0.0;
         s->plane_offset[i] = (k->flags & BODY_LOCK_PLANE) ? get_coded1(r, v3_dot(k->plane_normal, s->center[i]), what) : 0.0;
         if (r->failed) break;
-        if (!(fabs(s->center[i].x) <= RANGE_COORDINATE_MAX && fabs(s->center[i].y) <= RANGE_COORDINATE_MAX &&
-              fabs(s->center[i].z) <= RANGE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e12 m", i); break; }
+        if (!within_cube(s->center[i], RANGE_STATE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e18 m", i); break; }
         quat q = s->rotation[i];
         if (not_unit(q)) { bad(r, "body %d orientation is not unit", i); break; }
         if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX)) {
@@ -1485,7 +1484,7 @@ static int read_bodies(reader *r, carom_world *w)
          * the mass then; set_mass may lower the mass later) */
         if (!(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX) || !(s->sleep_time[i] >= 0) ||
             !(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX) ||
-            !(fabs(s->plane_offset[i]) <= RANGE_COORDINATE_MAX)) {
+            !(fabs(s->plane_offset[i]) <= RANGE_STATE_COORDINATE_MAX)) {
             bad(r, "body %d force, sleep timer or plane offset out of range", i);
             break;
         }
@@ -1499,8 +1498,7 @@ static int read_bodies(reader *r, carom_world *w)
         s->previous_origin[i] = (bits & REC_PREVIOUS) ? get_coded_v3(r, x.p, what) : x.p;
         s->previous_rotation[i] = (bits & REC_PREVIOUS) ? get_coded_q(r, x.q, what) : x.q;
         if (r->failed) break;
-        if (!(fabs(s->previous_origin[i].x) <= RANGE_COORDINATE_MAX && fabs(s->previous_origin[i].y) <= RANGE_COORDINATE_MAX &&
-              fabs(s->previous_origin[i].z) <= RANGE_COORDINATE_MAX)) { bad(r, "body %d previous pose is beyond 1e12 m", i); break; }
+        if (!within_cube(s->previous_origin[i], RANGE_STATE_COORDINATE_MAX)) { bad(r, "body %d previous pose is beyond 1e18 m", i); break; }
         quat pq = s->previous_rotation[i];
         if (not_unit(pq)) {
             bad(r, "body %d previous orientation is not unit", i);
@@ -1512,9 +1510,9 @@ static int read_bodies(reader *r, carom_world *w)
         if (r->failed) break;
         vec3 co = s->collided[i].p;
         quat cq = s->collided[i].q;
-        if (!within_cube(co, RANGE_COORDINATE_MAX) ||
+        if (!within_cube(co, RANGE_STATE_COORDINATE_MAX) ||
             not_unit(cq)) {
-            bad(r, "body %d collided pose is beyond 1e12 m or not unit", i);
+            bad(r, "body %d collided pose is beyond 1e18 m or not unit", i);
             break;
         }
         aabb predicted = predicted_fat_box(w, i), fat = predicted;
@@ -1601,7 +1599,11 @@ static int read_contacts(reader *r, carom_world *w)
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
-        contact_guess g = guess_contact(s, s->collided, sa, sb);
+        int child_a, child_b; /* the compound children a manifold number names must exist (its material is theirs) */
+        compound_sub_children(&s->shapes[sa], &s->shapes[sb], sub, &child_a, &child_b);
+        if ((child_a >= 0 && child_a >= s->shapes[sa].compound->count) || (child_b >= 0 && child_b >= s->shapes[sb].compound->count))
+            return bad(r, "contact %d: manifold %u names a compound child the bodies do not have", i, (unsigned)sub);
+        contact_guess g = guess_contact(s, s->collided, sa, sb, sub);
         c->flags = flags;
         c->sub_limit = sub_limit;
         c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
@@ -1614,8 +1616,8 @@ static int read_contacts(reader *r, carom_world *w)
             return bad(r, "contact %d has a normal it does not use", i);
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
         c->cache.normal = (bits & CREC_CACHE_NORMAL) ? get_coded_v3(r, cache_guess, "contact cache normal") : cache_guess;
-        double material[3] = {g.friction, g.restitution, 0}, guess[3] = {g.friction, g.restitution, 0};
-        if (bits & CREC_MATERIAL) get_coded(r, material, guess, 3, "contact material");
+        double material[3] = {g.material[0], g.material[1], g.material[2]};
+        if (bits & CREC_MATERIAL) get_coded(r, material, g.material, 3, "contact material");
         d->friction = material[0];
         d->restitution = material[1];
         d->rolling_resistance = material[2];

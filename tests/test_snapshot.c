@@ -283,12 +283,12 @@ static void test_bad_snapshots_refused(void **state)
     /* wrong version, foreign data */
     unsigned char *copy = malloc(s.size);
     memcpy(copy, s.data, s.size);
-    copy[8] = 3; /* the format before this one */
+    copy[8] = 4; /* the format before this one */
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
-    assert_non_null(strstr(msg, "version 3"));
-    copy[8] = 5;
+    assert_non_null(strstr(msg, "version 4"));
+    copy[8] = 6;
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
-    assert_non_null(strstr(msg, "version 5"));
+    assert_non_null(strstr(msg, "version 6"));
     memcpy(copy, "PNG\r\n\x1a\n\0", 8);
     assert_null(carom_world_restore(copy, s.size, msg, sizeof msg));
     assert_non_null(strstr(msg, "not a carom snapshot"));
@@ -347,12 +347,128 @@ static void fix_checksum(unsigned char *p, size_t n)
     for (int k = 0; k < 8; k++) p[24 + k] = (unsigned char)(h >> (8 * k));
 }
 
+/* Restores s, checks its snapshot is s again, and steps the two worlds side
+ * by side: every later snapshot byte-identical. */
+static void assert_restores_and_continues(carom_world *w, int steps, const char *what)
+{
+    snap s = take(w);
+    char msg[256];
+    carom_world *r = carom_world_restore(s.data, s.size, msg, sizeof msg);
+    if (!r) fail_msg("%s: restore refused: %s", what, msg);
+    assert_same_snap(s, take(r), 0);
+    for (int k = 1; k <= steps; k++) {
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        assert_int_equal(carom_world_step(r, 1.0 / 60), CAROM_OK);
+        snap a = take(w), b = take(r);
+        assert_same_snap(a, b, k);
+        free(a.data);
+        free(b.data);
+    }
+    free(s.data);
+    carom_world_destroy(r);
+}
+
+/* A step does not stop a body at the 1e12 m the calls allow: fuzz_api found
+ * one that fell past z = -1e12 and whose snapshot the reader refused ("body 0
+ * is beyond 1e12 m"). A plane-locked body at (1e12, 1e12, 0) with normal
+ * (1, 1, 0) has plane offset 1.41e12, also refused before. Both restore and
+ * continue bitwise; beyond the state bound (1e18 m) is refused. */
+static void test_bodies_past_the_position_range(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    carom_body_def b = carom_body_def_default();
+    b.shape = carom_shape_sphere(0.5);
+    b.position = vec(3, -1e12, -1e12);
+    b.linear_velocity = vec(0, -2000, -3000);
+    carom_body_id fall = carom_body_create(w, &b);
+    carom_body_def p = carom_body_def_default();
+    p.shape = carom_shape_box(0.5, 0.5, 0.5);
+    p.position = vec(1e12, 1e12, 0);
+    p.lock_to_plane = 1;
+    p.plane_normal = vec(1, 1, 0);
+    p.linear_velocity = vec(4000, 4000, 0);
+    carom_body_create(w, &p);
+    for (int k = 0; k < 3; k++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+    carom_vec3 at;
+    assert_int_equal(carom_body_get_position(w, fall, &at), CAROM_OK);
+    assert_true(at.z < -1e12 && at.y < -1e12);
+    assert_restores_and_continues(w, 20, "bodies past 1e12 m");
+    carom_world_destroy(w);
+}
+
+/* A contact's friction, restitution and rolling resistance are predicted as
+ * material.c mixes them (every combine mode, compound children's own
+ * materials): the worlds restore and continue bitwise, with and without. */
+static void test_contact_materials_predicted(void **state)
+{
+    (void)state;
+    size_t size[2];
+    for (int with = 0; with < 2; with++) {
+        carom_world_def wd = carom_world_def_default();
+        carom_world *w = carom_world_create(&wd);
+        carom_body_def g = carom_body_def_default();
+        g.type = CAROM_BODY_STATIC;
+        g.shape = carom_shape_plane(0, 0, 1, 0);
+        carom_material ground = carom_material_default();
+        ground.friction = 0.9;
+        ground.restitution = 0.1;
+        ground.rolling_resistance = 0.05;
+        ground.combine = CAROM_COMBINE_AVERAGE;
+        if (with) g.material = &ground;
+        carom_body_create(w, &g);
+        for (int i = 0; i < 30; i++) {
+            carom_material m = carom_material_default();
+            m.friction = 0.2 + 0.03 * i;
+            m.restitution = 0.01 * i;
+            m.rolling_resistance = 0.01 * (i % 7);
+            m.combine = (carom_combine_mode)(i % 6);
+            carom_body_def b = carom_body_def_default();
+            b.shape = i % 3 == 0 ? carom_shape_sphere(0.2) : i % 3 == 1 ? carom_shape_box(0.2, 0.2, 0.2) : carom_shape_capsule(0.1, 0.2);
+            b.position = vec(0.45 * (i % 6), 0.45 * (i / 6), 0.21);
+            if (with) b.material = &m;
+            carom_body_create(w, &b);
+        }
+        if (with) { /* a compound whose children have their own materials */
+            carom_material cm[2] = {carom_material_default(), carom_material_default()};
+            cm[0].friction = 0.3;
+            cm[0].rolling_resistance = 0.2;
+            cm[0].combine = CAROM_COMBINE_MAX;
+            cm[1].restitution = 0.4;
+            cm[1].combine = CAROM_COMBINE_MULTIPLY;
+            carom_compound_child ch[2];
+            for (int k = 0; k < 2; k++) {
+                ch[k] = carom_compound_child_default(carom_shape_box(0.2, 0.2, 0.2));
+                ch[k].position = vec(0.4 * k, 0, 0);
+                ch[k].material = &cm[k];
+            }
+            carom_body_def b = carom_body_def_default();
+            b.shape.type = CAROM_SHAPE_COMPOUND;
+            b.children = ch;
+            b.child_count = 2;
+            b.position = vec(-1, 0, 0.21);
+            carom_body_create(w, &b);
+        }
+        for (int k = 0; k < 30; k++) assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        carom_world_stats st = carom_world_stats_init();
+        carom_world_get_stats(w, &st);
+        assert_true(st.contacts >= 30);
+        size[with] = carom_world_snapshot(w, NULL, 0);
+        assert_restores_and_continues(w, 30, with ? "materials" : "no materials");
+        carom_world_destroy(w);
+    }
+    printf("materials: %zu bytes without, %zu with\n", size[0], size[1]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_empty_world_and_errors),
         cmocka_unit_test(test_restore_continues_bitwise),
         cmocka_unit_test(test_bad_snapshots_refused),
+        cmocka_unit_test(test_bodies_past_the_position_range),
+        cmocka_unit_test(test_contact_materials_predicted),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
