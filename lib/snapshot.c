@@ -100,6 +100,16 @@ typedef struct reader {
  * a vector inside the cube |x|, |y|, |z| <= limit (NaN fails it). */
 static int not_unit(quat q) { return fabs(q_len(q) - 1.0) > 1e-6; }
 static int within_cube(vec3 v, double limit) { return fabs(v.x) <= limit && fabs(v.y) <= limit && fabs(v.z) <= limit; }
+/* A direction the state holds (manifold normal, cache normal, normal in A's
+ * frame, friction basis): zero where unused, else unit as computed; the
+ * narrowphase itself keeps any normal of length^2 >= 0.5, so the reader takes
+ * lengths in [0.5, 2] (a fuzzed normal of length 4.8e232 made 2 bodies NaN) */
+static int bad_direction(vec3 v)
+{
+    if (v.x == 0 && v.y == 0 && v.z == 0) return 0;
+    double l = v3_len(v);
+    return !(l >= 0.5 && l <= 2.0);
+}
 
 static int bad(reader *r, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -1637,6 +1647,12 @@ static int read_contacts(reader *r, carom_world *w)
             d->normal_a = (bits & CREC_NORMAL_A) ? get_coded_v3(r, normal_a, "contact normal") : normal_a;
         }
         if (r->failed) return 0;
+        if (bad_direction(d->m.normal) || bad_direction(c->cache.normal) || bad_direction(d->tangent1) ||
+            ((flags & CONTACT_REUSABLE) && bad_direction(d->normal_a)))
+            return bad(r, "contact %d: a normal or friction basis of length outside [0.5, 2]", i);
+        if (posed && (!within_cube(c->rel_pose.p, 2 * RANGE_STATE_COORDINATE_MAX) ||
+                      !(q_len(c->rel_pose.q) >= 0.5 && q_len(c->rel_pose.q) <= 2.0)))
+            return bad(r, "contact %d: the pose is beyond 2e18 m or its rotation not near unit", i);
         {
             xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
             double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
@@ -1669,8 +1685,9 @@ static int read_contacts(reader *r, carom_world *w)
             p->point = (bits & CREC_EXACT) ? point : get_coded_v3(r, point, "manifold point");
             p->separation = (bits & CREC_EXACT) ? separation : get_coded1(r, separation, "manifold point");
             if (!same_bits(&point, &p->point, sizeof point) || f64_bits(separation) != f64_bits(p->separation)) inexact = 1;
-            if (!(isfinite(p->point.x) && isfinite(p->point.y) && isfinite(p->point.z) && isfinite(p->separation)))
-                return bad(r, "contact %d: a point or separation is not finite", i);
+            if (!(within_cube(p->point, RANGE_STATE_COORDINATE_MAX) && fabs(p->separation) <= RANGE_STATE_COORDINATE_MAX &&
+                  within_cube(st->local_a, RANGE_STATE_COORDINATE_MAX) && fabs(st->separation) <= RANGE_STATE_COORDINATE_MAX))
+                return bad(r, "contact %d: a point or separation is beyond 1e18 m (or not finite)", i);
             memcpy(last, cur, sizeof cur);
             /* warm-start impulses the solver could have stored (a fuzzed one of
              * 1.7e307 N s threw a hull 1.9e303 m in one step) */
