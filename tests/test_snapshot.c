@@ -355,7 +355,9 @@ static void assert_restores_and_continues(carom_world *w, int steps, const char 
     char msg[256];
     carom_world *r = carom_world_restore(s.data, s.size, msg, sizeof msg);
     if (!r) fail_msg("%s: restore refused: %s", what, msg);
-    assert_same_snap(s, take(r), 0);
+    snap again = take(r);
+    assert_same_snap(s, again, 0);
+    free(again.data);
     for (int k = 1; k <= steps; k++) {
         assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
         assert_int_equal(carom_world_step(r, 1.0 / 60), CAROM_OK);
