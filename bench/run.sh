@@ -111,5 +111,5 @@ phase "publish: docs/bench/ and the README's presets table from this run"
 lua5.4 publish.lua "$out" ../docs/bench ../README.md
 
 echo
-echo "bench: done in $(elapsed); results in bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto.txt," \
+echo "bench: done in $(elapsed); results in build/bench/out/ (peers.txt, broadphase.txt, sweep.csv, pareto.txt," \
      "pareto_*.png/.svg, scaling.csv, scaling.png/.svg, pyramids.csv, pyramids_ms/_us.png/.svg, narrowphase.txt, extremes.txt, snapshot.txt)"
