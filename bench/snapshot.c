@@ -11,13 +11,15 @@
  * others keeps a slow spin about the vertical that friction cannot take
  * away, so islands sleep below 0.2 rad/s (surface speed 4 cm/s at r 0.2 m)
  * instead of the default 0.05.
- * Targets (issue 17): <= 256 bytes per body, < 5 ms each. */
+ * Targets (issue 17): <= 256 bytes per body, < 5 ms each. It also prints
+ * where the bytes go, per field (lib/snapshot.h, snapshot_field_bytes). */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include "carom/carom.h"
+#include "snapshot.h" /* internal: bytes per field */
 
 static double now_ms(void)
 {
@@ -32,9 +34,9 @@ static int cmp(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-int main(int argc, char **argv)
+/* The settled pile (see the top of the file). */
+static carom_world *settled_pile(int n)
 {
-    int n = argc > 1 ? atoi(argv[1]) : 10000;
     carom_world_def wd = carom_world_def_default();
     wd.sleep_angular_velocity = 0.2;
     carom_world *w = carom_world_create(&wd);
@@ -70,8 +72,55 @@ int main(int argc, char **argv)
     } while (st.awake_bodies > n / 100 && steps < 2400);
     printf("pile of %d bodies: %d steps to settle (%.1f s), %d awake, %d broadphase pairs, %d touching manifolds\n", n,
            steps, (now_ms() - t0) / 1e3, st.awake_bodies, st.pairs, st.contacts);
+    return w;
+}
+
+/* snapshot [N] [-o FILE]: the pile of N bodies (10,000), its snapshot saved
+ * to FILE when asked; snapshot -i FILE: a saved snapshot's world instead
+ * (no settling: for callgrind, e.g. --toggle-collect=carom_world_restore). */
+int main(int argc, char **argv)
+{
+    const char *in = NULL, *out = NULL;
+    int n = 10000;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "-i") && i + 1 < argc) in = argv[++i];
+        else if (!strcmp(argv[i], "-o") && i + 1 < argc) out = argv[++i];
+        else n = atoi(argv[i]);
+    }
+    carom_world *w;
+    if (in) {
+        FILE *f = fopen(in, "rb");
+        if (!f) { perror(in); return 1; }
+        fseek(f, 0, SEEK_END);
+        long len = ftell(f);
+        fseek(f, 0, SEEK_SET);
+        unsigned char *data = malloc(len > 0 ? (size_t)len : 1);
+        if (!data || len <= 0 || fread(data, 1, (size_t)len, f) != (size_t)len) { fprintf(stderr, "%s: cannot read\n", in); return 1; }
+        fclose(f);
+        char msg[256];
+        w = carom_world_restore(data, (size_t)len, msg, sizeof msg);
+        free(data);
+        if (!w) { fprintf(stderr, "%s: %s\n", in, msg); return 1; }
+        n = carom_world_body_count(w) - 1;
+    } else {
+        w = settled_pile(n);
+    }
     size_t size = carom_world_snapshot(w, NULL, 0);
+    {
+        size_t bytes[SNAP_FIELD_COUNT];
+        const char *names[SNAP_FIELD_COUNT];
+        snapshot_field_bytes(w, bytes, names);
+        printf("bytes per body by field:");
+        for (int f = 0, k = 0; f < SNAP_FIELD_COUNT; f++)
+            if (bytes[f]) printf("%s %s %.1f", k++ % 6 ? "," : "\n ", names[f], (double)bytes[f] / (n + 1));
+        printf("\n");
+    }
     unsigned char *buf = malloc(size);
+    if (out) {
+        FILE *f = fopen(out, "wb");
+        carom_world_snapshot(w, buf, size);
+        if (!f || fwrite(buf, 1, size, f) != size || fclose(f) != 0) { perror(out); return 1; }
+    }
     double ts[9], tr[9];
     for (int k = 0; k < 9; k++) {
         double a = now_ms();

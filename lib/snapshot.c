@@ -23,6 +23,7 @@
 #include "heightfield.h"
 #include "compound.h"
 #include "material.h"
+#include "snapshot.h"
 
 #define SNAP_MAGIC "CAROMSNP"
 #define SNAP_VERSION 5u
@@ -41,7 +42,14 @@
 typedef struct writer {
     unsigned char *buf;
     size_t cap, pos;
+    size_t *acct;           /* snapshot_field_bytes: bytes per field, else NULL */
 } writer;
+
+/* The bytes written since `since` go to field f (snapshot_field_bytes). */
+static void acct(writer *o, int f, size_t since)
+{
+    if (o->acct) o->acct[f] += o->pos - since;
+}
 
 static void put_bytes(writer *o, const void *p, size_t n)
 {
@@ -891,7 +899,7 @@ static int build_classes(const body_store *s, class_table *t)
     t->start[0] = 0;
     for (int i = 0; i < n; i++) {
         size_t at = t->start[t->count];
-        writer o = {t->bytes, total, at};
+        writer o = {t->bytes, total, at, NULL};
         write_class(&o, s, i);
         if (o.pos > total) {
             size_t grown = total;
@@ -905,7 +913,7 @@ static int build_classes(const body_store *s, class_table *t)
             }
             t->bytes = more;
             total = grown;
-            o = (writer){t->bytes, total, at};
+            o = (writer){t->bytes, total, at, NULL};
             write_class(&o, s, i);
         }
         size_t len = o.pos - at;
@@ -970,9 +978,11 @@ static unsigned body_bits(const body_store *s, int i, xform x, aabb fat, int mov
 static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
 {
     const body_store *s = &w->bodies;
+    size_t at = o->pos;
     put_varint(o, (uint64_t)t->count);
     put_bytes(o, t->bytes, t->size);
     put_varint(o, (uint64_t)s->count);
+    acct(o, SNAP_FIELD_classes, at);
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
@@ -980,28 +990,50 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t, 
         xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
         unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]));
+        at = o->pos;
         put_varint(o, bits);
         put_varint(o, (uint64_t)t->of_body[i]);
+        acct(o, SNAP_FIELD_body_header, at);
+        at = o->pos;
         put_coded_v3(o, s->center[i], last_center);
+        acct(o, SNAP_FIELD_body_center, at);
+        at = o->pos;
         put_coded_q(o, s->rotation[i], last_rotation);
+        acct(o, SNAP_FIELD_body_orientation, at);
         last_center = s->center[i];
         last_rotation = s->rotation[i];
+        at = o->pos;
         if (bits & REC_VELOCITY) put_coded_v3(o, s->velocity[i], v3(0, 0, 0));
+        acct(o, SNAP_FIELD_body_velocity, at);
+        at = o->pos;
         if (bits & REC_SPIN) put_coded_v3(o, s->angular_velocity[i], v3(0, 0, 0));
+        acct(o, SNAP_FIELD_body_spin, at);
+        at = o->pos;
         if (bits & REC_FORCE) put_coded_v3(o, s->force[i], v3(0, 0, 0));
         if (bits & REC_TORQUE) put_coded_v3(o, s->torque[i], v3(0, 0, 0));
+        acct(o, SNAP_FIELD_body_force, at);
+        at = o->pos;
         if (bits & REC_SLEEP_TIME) { put_coded1(o, s->sleep_time[i], last_sleep); last_sleep = s->sleep_time[i]; }
+        acct(o, SNAP_FIELD_body_sleep, at);
+        at = o->pos;
         if (s->flags[i] & BODY_LOCK_PLANE) put_coded1(o, s->plane_offset[i], v3_dot(s->plane_normal[i], s->center[i]));
+        acct(o, SNAP_FIELD_body_plane, at);
+        at = o->pos;
         if (bits & REC_PREVIOUS) {
             put_coded_v3(o, s->previous_origin[i], x.p);
             put_coded_q(o, s->previous_rotation[i], x.q);
         }
+        acct(o, SNAP_FIELD_body_previous, at);
+        at = o->pos;
         if (bits & REC_COLLIDED) {
             xform p = previous_pose(s, i);
             put_coded_v3(o, s->collided[i].p, p.p);
             put_coded_q(o, s->collided[i].q, p.q);
         }
+        acct(o, SNAP_FIELD_body_collided, at);
+        at = o->pos;
         if (bits & REC_FAT) { put_coded_v3(o, s->fat_box[i].lo, fat.lo); put_coded_v3(o, s->fat_box[i].hi, fat.hi); }
+        acct(o, SNAP_FIELD_body_fat, at);
     }
 }
 
@@ -1136,6 +1168,7 @@ static void write_contacts(writer *o, const carom_world *w)
                     f64_bits(separation) == f64_bits(d->m.points[k].separation);
         }
         if (exact) bits |= CREC_EXACT;
+        size_t at = o->pos;
         put_varint(o, zigzag((int64_t)c->id_a - last_a));
         put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
         last_a = c->id_a;
@@ -1144,23 +1177,42 @@ static void write_contacts(writer *o, const carom_world *w)
         if (bits & CREC_SUB) put_varint(o, c->sub);
         if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
         if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
+        acct(o, SNAP_FIELD_contact_header, at);
+        at = o->pos;
         if (bits & CREC_NORMAL) put_coded_v3(o, normal, v3(0, 0, 0));
+        acct(o, SNAP_FIELD_contact_normal, at);
+        at = o->pos;
         if (bits & CREC_CACHE_NORMAL) put_coded_v3(o, c->cache.normal, cache_guess);
+        acct(o, SNAP_FIELD_contact_cache_normal, at);
+        at = o->pos;
         if (bits & CREC_MATERIAL) {
             double v[3] = {d->friction, d->restitution, d->rolling_resistance};
             put_coded(o, v, g.material, 3);
         }
+        acct(o, SNAP_FIELD_contact_material, at);
+        at = o->pos;
         if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, basis_guess(c->cache.normal));
+        acct(o, SNAP_FIELD_contact_basis, at);
         /* only what the collision stage reads under each flag (collision.c):
          * the pose and gap of a pair known apart, the pose and normal of a
          * manifold it may reuse */
         if (bits & CREC_POSE) {
+            at = o->pos;
             put_coded_v3(o, c->rel_pose.p, rel.p);
+            acct(o, SNAP_FIELD_contact_rel_position, at);
+            at = o->pos;
             put_coded_q(o, c->rel_pose.q, rel.q);
+            acct(o, SNAP_FIELD_contact_rel_rotation, at);
         }
+        at = o->pos;
         if (c->flags & CONTACT_APART) put_coded1(o, c->gap, 0.0);
+        acct(o, SNAP_FIELD_contact_gap, at);
+        at = o->pos;
         if (bits & CREC_REACH) put_coded1(o, c->reach_b, reach);
+        acct(o, SNAP_FIELD_contact_reach, at);
+        at = o->pos;
         if (bits & CREC_NORMAL_A) put_coded_v3(o, d->normal_a, normal_a);
+        acct(o, SNAP_FIELD_contact_normal_a, at);
         /* each point against the one before it (a manifold's points share
          * their scale, most bits of their impulses, often all but a sign) */
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
@@ -1172,12 +1224,27 @@ static void write_contacts(writer *o, const carom_world *w)
             vec3 point;
             double separation;
             point_guess(&m, d, g.xa, st, &point, &separation);
+            at = o->pos;
             put_varint(o, p->id);
+            acct(o, SNAP_FIELD_point_id, at);
+            at = o->pos;
             put_coded(o, cur, last, 3);
+            acct(o, SNAP_FIELD_point_local, at);
+            at = o->pos;
             put_coded(o, cur + 3, last + 3, 4);
+            if (o->acct) { /* the group's bytes by value: half a tag byte each, and its payload */
+                static const int field[4] = {SNAP_FIELD_point_separation, SNAP_FIELD_point_normal_impulse,
+                                             SNAP_FIELD_point_tangent_impulse, SNAP_FIELD_point_tangent_impulse};
+                for (int v = 0; v < 4; v++) {
+                    int tg = coded_tag(f64_bits(cur[3 + v]) ^ f64_bits(last[3 + v]));
+                    o->acct[field[v]] += (size_t)(tg <= 8 ? tg : 16 - tg) + (v % 2 == 0 ? 1 : 0);
+                }
+            }
             if (!exact) {
+                size_t pw = o->pos;
                 put_coded_v3(o, p->point, point);
                 put_coded1(o, p->separation, separation);
+                acct(o, SNAP_FIELD_point_world, pw);
             }
             memcpy(last, cur, sizeof cur);
         }
@@ -1187,10 +1254,12 @@ static void write_contacts(writer *o, const carom_world *w)
 static void write_world(writer *o, const carom_world *w, const class_table *t, const xform *pose)
 {
     const body_store *s = &w->bodies;
+    size_t at = o->pos;
     write_def(o, &w->def);
     put_f64(o, 0.0); /* reserved: was the last step's dt (each step now carries its own) */
     put_u64(o, (uint64_t)w->stats.step_count);
-
+    acct(o, SNAP_FIELD_settings, at);
+    at = o->pos;
     put_varint(o, (uint64_t)s->id_count);
     put_varint(o, (uint64_t)(s->free_id + 1));
     for (int i = 0; i < s->id_count; i++) {
@@ -1198,19 +1267,41 @@ static void write_world(writer *o, const carom_world *w, const class_table *t, c
         put_varint(o, s->ids[i].generation);
         put_varint(o, (uint64_t)(s->ids[i].next_free + 1));
     }
+    acct(o, SNAP_FIELD_ids, at);
     write_bodies(o, w, t, pose);
     write_contacts(o, w);
     /* the sensors' overlaps after the last step (sensor.c): their next events */
+    at = o->pos;
     put_varint(o, (uint64_t)w->sensor_overlap_count);
     for (int i = 0; i < w->sensor_overlap_count; i++) {
         put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].sensor));
         put_u64(o, carom_body_id_pack(w->sensor_overlaps[i].other));
     }
+    acct(o, SNAP_FIELD_sensors, at);
 }
+
+static size_t snapshot_to(const carom_world *w, void *buf, size_t capacity, size_t *bytes);
 
 CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t capacity)
 {
     if (!w) return 0;
+    return snapshot_to(w, buf, capacity, NULL);
+}
+
+size_t snapshot_field_bytes(const carom_world *w, size_t bytes[SNAP_FIELD_COUNT], const char *names[SNAP_FIELD_COUNT])
+{
+#define SNAP_FIELD_NAME(f) #f,
+    static const char *const field_names[SNAP_FIELD_COUNT] = {SNAP_FIELDS(SNAP_FIELD_NAME)};
+#undef SNAP_FIELD_NAME
+    for (int f = 0; f < SNAP_FIELD_COUNT; f++) {
+        bytes[f] = 0;
+        names[f] = field_names[f];
+    }
+    return snapshot_to(w, NULL, 0, bytes);
+}
+
+static size_t snapshot_to(const carom_world *w, void *buf, size_t capacity, size_t *bytes)
+{
     if (w->locked) {
         world_fail(w, CAROM_ERROR_LOCKED, "world_snapshot: the world is inside its step; snapshot it afterwards");
         return 0;
@@ -1225,17 +1316,18 @@ CAROM_API size_t carom_world_snapshot(const carom_world *w, void *buf, size_t ca
     }
     for (int i = 0; i < n; i++) pose[i] = body_xform(&w->bodies, i);
     if (!buf) capacity = 0;
-    writer o = {buf, capacity, 0};
+    writer o = {buf, capacity, 0, bytes};
     put_bytes(&o, SNAP_MAGIC, 8);
     put_u32(&o, SNAP_VERSION);
     put_u32(&o, SNAP_HEADER_SIZE);
     put_u64(&o, 0); /* total size, filled below */
     put_u64(&o, 0); /* checksum, filled below */
+    acct(&o, SNAP_FIELD_header, 0);
     write_world(&o, w, &t, pose);
     class_table_free(&t);
     free(pose);
     if (o.pos <= capacity) {
-        writer h = {buf, capacity, 16};
+        writer h = {buf, capacity, 16, NULL};
         put_u64(&h, (uint64_t)o.pos);
         put_u64(&h, checksum((const unsigned char *)buf + SNAP_HEADER_SIZE, o.pos - SNAP_HEADER_SIZE));
     }
