@@ -9,49 +9,72 @@
 #include "contact.h"
 #include "step.h"
 
-/* Hot fields first, in the order the solve pass reads them: the normal row,
- * then the friction rows; what only preparation, restitution or the shock
- * and penalty paths read comes last. */
+/* A point as every manifold has it: what the stages around the passes read
+ * (the shock pass, impacts, impulse storage, hit and force events). The
+ * rows the scalar passes solve are in constraint_rows; a wide-solved
+ * manifold's rows live only in its batch's lanes (solver_wide.c). */
 typedef struct constraint_point {
     double base_separation;
-    double normal_mass, normal_impulse;
-    double total_normal_impulse, max_normal_impulse;
+    double normal_impulse, tangent_impulse[2];
+    double total_normal_impulse;
+    double relative_velocity;    /* normal velocity before solving (restitution, hit events) */
+    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
+} constraint_point;
+
+/* A scalar-solved point's rows (contact_solver.c, penalty.c), hot fields
+ * first in the order the solve pass reads them: the normal row, then the
+ * friction rows. */
+typedef struct constraint_rows {
+    double normal_mass;
     vec3 ra_n, rb_n;             /* ra x n, rb x n */
     vec3 ia_n, ib_n;             /* IA^-1 (ra x n), IB^-1 (rb x n) */
-    double tangent_mass[2], tangent_impulse[2];
+    double tangent_mass[2];
     vec3 ra_t[2], rb_t[2];       /* ra x t_k, rb x t_k (friction rows) */
     vec3 ia_t[2], ib_t[2];       /* IA^-1 (ra x t_k), IB^-1 (rb x t_k) */
-    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
-    double relative_velocity;    /* normal velocity before solving (restitution) */
-    double penalty_k, penalty_c; /* penalty model spring and damper */
-    double shock_normal;         /* shock pass impulse: this pass only, never warm-started */
-} constraint_point;
+} constraint_rows;
+
+/* The penalty model's spring and damper of a point (penalty.c only). */
+typedef struct penalty_spring {
+    double k, c;
+} penalty_spring;
+
+/* What only plane-locked or rolling manifolds need (the rest have none). */
+typedef struct constraint_extra {
+    /* plane-locked bodies (lock_to_plane): the plane normals, zero for a free body */
+    vec3 lock_a, lock_b;
+    /* rolling resistance (material.c): an angular row per tangent axis,
+     * capped at rolling * rolling_radius * normal impulse */
+    double rolling_radius;
+    double rolling_mass[2], rolling_impulse[2];
+} constraint_extra;
 
 typedef struct contact_constraint {
     int a, b;                    /* solver bodies (0 = the shared static body) */
     int contact;                 /* index in the contact set */
     int count;
     int level;                   /* shock propagation: lower of the two body levels */
+    int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
+    /* plane-locked bodies (1: a, 2: b); such a manifold takes the scalar
+     * passes, which keep the locked bodies' velocities in their planes */
+    int locked;
     vec3 n, t1, t2;
     double friction, restitution;
+    double rolling;              /* rolling resistance (0: no rolling rows, the manifold may go wide) */
     softness soft;
     constraint_point *p;         /* count points in the step's packed point array */
-    int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
+    constraint_rows *r;          /* their rows: scalar passes only (NULL for a wide-solved manifold) */
+    penalty_spring *spring;      /* their springs: penalty model only, else NULL */
+    constraint_extra *x;         /* locked or rolling manifolds only, else NULL */
     /* what preparing the points reads */
     const manifold *m;
     const contact_point_state *warm; /* last step's impulses, matched by feature */
     vec3 center_a, center_b;     /* centres of mass */
     double gravity_closing;      /* normal acceleration of b relative to a from gravity and forces */
-    /* plane-locked bodies (lock_to_plane): the plane normals, zero for a free
-     * body; such a manifold takes the scalar passes, which keep the locked
-     * bodies' velocities in their planes */
-    vec3 lock_a, lock_b;
-    int locked;
-    /* rolling resistance (material.c; 0: no rolling rows, the manifold may go wide): an
-     * angular row per tangent axis, capped at rolling * rolling_radius * normal impulse */
-    double rolling, rolling_radius;
-    double rolling_mass[2], rolling_impulse[2];
 } contact_constraint;
+
+/* The plane normals of a manifold's bodies (zero for a free body). */
+static inline vec3 constraint_lock_a(const contact_constraint *c) { return c->x ? c->x->lock_a : v3_zero(); }
+static inline vec3 constraint_lock_b(const contact_constraint *c) { return c->x ? c->x->lock_b : v3_zero(); }
 
 /* ---- the shared formulas ------------------------------------------------ */
 

@@ -13,14 +13,16 @@
  * as a block sliding with friction c would (the larger R of two bodies). */
 static void prepare_rolling(contact_constraint *c, const impulse_body *A, const impulse_body *B)
 {
-    c->rolling_impulse[0] = c->rolling_impulse[1] = 0.0;
-    c->rolling_mass[0] = c->rolling_mass[1] = 0.0;
-    c->rolling_radius = 0.0;
+    constraint_extra *x = c->x;
+    if (!x) return; /* no rolling rows (every reader checks c->rolling first) */
+    x->rolling_impulse[0] = x->rolling_impulse[1] = 0.0;
+    x->rolling_mass[0] = x->rolling_mass[1] = 0.0;
+    x->rolling_radius = 0.0;
     if (!(c->rolling > 0.0) || c->count < 1) return;
     vec3 t[2] = {c->t1, c->t2};
     for (int q = 0; q < 2; q++) {
         double k = v3_dot(t[q], m3_mulv(A->inv_inertia, t[q])) + v3_dot(t[q], m3_mulv(B->inv_inertia, t[q]));
-        c->rolling_mass[q] = k > 0.0 ? 1.0 / k : 0.0;
+        x->rolling_mass[q] = k > 0.0 ? 1.0 / k : 0.0;
     }
     vec3 mid = v3_zero();
     for (int j = 0; j < c->count; j++) mid = v3_add(mid, c->m->points[j].point);
@@ -32,7 +34,7 @@ static void prepare_rolling(contact_constraint *c, const impulse_body *A, const 
         double r = fabs(v3_dot(c->n, v3_sub(mid, centre[i])));
         double inv_it = 0.5 * (v3_dot(t[0], m3_mulv(X->inv_inertia, t[0])) + v3_dot(t[1], m3_mulv(X->inv_inertia, t[1])));
         if (!(X->inv_mass > 0.0 && inv_it > 0.0 && r > 0.0)) continue;
-        c->rolling_radius = dmax(c->rolling_radius, r + X->inv_mass / (inv_it * r));
+        x->rolling_radius = dmax(x->rolling_radius, r + X->inv_mass / (inv_it * r));
     }
 }
 
@@ -40,13 +42,14 @@ static void solve_rolling(contact_constraint *c, vec3 *wA, vec3 *wB, const impul
 {
     double normal = 0.0;
     for (int j = 0; j < c->count; j++) normal += c->p[j].normal_impulse;
+    constraint_extra *x = c->x;
     vec3 rel = v3_sub(*wB, *wA);
-    double o1 = c->rolling_impulse[0], o2 = c->rolling_impulse[1];
-    double n1 = o1 - c->rolling_mass[0] * v3_dot(c->t1, rel);
-    double n2 = o2 - c->rolling_mass[1] * v3_dot(c->t2, rel);
-    coulomb_clamp(&n1, &n2, c->rolling * c->rolling_radius * normal);
-    c->rolling_impulse[0] = n1;
-    c->rolling_impulse[1] = n2;
+    double o1 = x->rolling_impulse[0], o2 = x->rolling_impulse[1];
+    double n1 = o1 - x->rolling_mass[0] * v3_dot(c->t1, rel);
+    double n2 = o2 - x->rolling_mass[1] * v3_dot(c->t2, rel);
+    coulomb_clamp(&n1, &n2, c->rolling * x->rolling_radius * normal);
+    x->rolling_impulse[0] = n1;
+    x->rolling_impulse[1] = n2;
     vec3 L = v3_add(v3_scale(c->t1, n1 - o1), v3_scale(c->t2, n2 - o2));
     *wA = v3_sub(*wA, m3_mulv(A->inv_inertia, L));
     *wB = v3_add(*wB, m3_mulv(B->inv_inertia, L));
@@ -63,35 +66,37 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
      * is already the reduced n n^T / (n.I n)) */
     double lin_n = A->inv_mass + B->inv_mass, lin_1 = lin_n, lin_2 = lin_n;
     if (c->locked) {
-        lin_n = locked_inv_mass(A->inv_mass, c->n, c->lock_a) + locked_inv_mass(B->inv_mass, c->n, c->lock_b);
-        lin_1 = locked_inv_mass(A->inv_mass, c->t1, c->lock_a) + locked_inv_mass(B->inv_mass, c->t1, c->lock_b);
-        lin_2 = locked_inv_mass(A->inv_mass, c->t2, c->lock_a) + locked_inv_mass(B->inv_mass, c->t2, c->lock_b);
+        vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
+        lin_n = locked_inv_mass(A->inv_mass, c->n, la) + locked_inv_mass(B->inv_mass, c->n, lb);
+        lin_1 = locked_inv_mass(A->inv_mass, c->t1, la) + locked_inv_mass(B->inv_mass, c->t1, lb);
+        lin_2 = locked_inv_mass(A->inv_mass, c->t2, la) + locked_inv_mass(B->inv_mass, c->t2, lb);
     }
     for (int j = 0; j < c->count; j++) {
         const manifold_point *mp = &c->m->points[j];
         constraint_point *p = &c->p[j];
+        constraint_rows *r = &c->r[j];
         p->ra = v3_sub(mp->point, ca);
         p->rb = v3_sub(mp->point, cb);
-        p->ra_n = v3_cross(p->ra, c->n);
-        p->rb_n = v3_cross(p->rb, c->n);
-        p->ia_n = m3_mulv(A->inv_inertia, p->ra_n);
-        p->ib_n = m3_mulv(B->inv_inertia, p->rb_n);
-        p->ra_t[0] = v3_cross(p->ra, c->t1);
-        p->rb_t[0] = v3_cross(p->rb, c->t1);
-        p->ra_t[1] = v3_cross(p->ra, c->t2);
-        p->rb_t[1] = v3_cross(p->rb, c->t2);
+        r->ra_n = v3_cross(p->ra, c->n);
+        r->rb_n = v3_cross(p->rb, c->n);
+        r->ia_n = m3_mulv(A->inv_inertia, r->ra_n);
+        r->ib_n = m3_mulv(B->inv_inertia, r->rb_n);
+        r->ra_t[0] = v3_cross(p->ra, c->t1);
+        r->rb_t[0] = v3_cross(p->rb, c->t1);
+        r->ra_t[1] = v3_cross(p->ra, c->t2);
+        r->rb_t[1] = v3_cross(p->rb, c->t2);
         for (int q = 0; q < 2; q++) {
-            p->ia_t[q] = m3_mulv(A->inv_inertia, p->ra_t[q]);
-            p->ib_t[q] = m3_mulv(B->inv_inertia, p->rb_t[q]);
+            r->ia_t[q] = m3_mulv(A->inv_inertia, r->ra_t[q]);
+            r->ib_t[q] = m3_mulv(B->inv_inertia, r->rb_t[q]);
         }
         /* the seed's denominator 1/m1 + 1/m2 + n.((I1^-1 (r1 x n)) x r1) + ..., from the
          * rows above: n.((I^-1 (r x n)) x r) = (I^-1 (r x n)).(r x n) */
-        double kn = lin_n + v3_dot(p->ia_n, p->ra_n) + v3_dot(p->ib_n, p->rb_n);
-        double k1 = lin_1 + v3_dot(p->ia_t[0], p->ra_t[0]) + v3_dot(p->ib_t[0], p->rb_t[0]);
-        double k2 = lin_2 + v3_dot(p->ia_t[1], p->ra_t[1]) + v3_dot(p->ib_t[1], p->rb_t[1]);
-        p->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
-        p->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
-        p->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
+        double kn = lin_n + v3_dot(r->ia_n, r->ra_n) + v3_dot(r->ib_n, r->rb_n);
+        double k1 = lin_1 + v3_dot(r->ia_t[0], r->ra_t[0]) + v3_dot(r->ib_t[0], r->rb_t[0]);
+        double k2 = lin_2 + v3_dot(r->ia_t[1], r->ra_t[1]) + v3_dot(r->ib_t[1], r->rb_t[1]);
+        r->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
+        r->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
+        r->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
         p->base_separation = mp->separation;
         p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n),
                                                          c->gravity_closing, mp->separation);
@@ -99,8 +104,7 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         p->tangent_impulse[0] = ws * c->warm[j].tangent_impulse[0];
         p->tangent_impulse[1] = ws * c->warm[j].tangent_impulse[1];
         p->total_normal_impulse = 0.0;
-        p->max_normal_impulse = 0.0;
-        if (ctx->penalty) penalty_prepare_point(p, ctx);
+        if (ctx->penalty) penalty_prepare_point(p, r, &c->spring[j], ctx);
         if (-mp->separation > deepest) deepest = -mp->separation;
     }
     prepare_rolling(c, A, B);
@@ -117,10 +121,13 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
         p->total_normal_impulse += p->normal_impulse;
         /* seed convention: body 1 = B receives +P (n points from A to B) */
         impulse_apply(B, A, p->rb, p->ra, P);
-        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+        if (c->locked) {
+            A->v = keep_in_plane(A->v, constraint_lock_a(c));
+            B->v = keep_in_plane(B->v, constraint_lock_b(c));
+        }
     }
     if (c->rolling > 0.0) {
-        vec3 L = v3_add(v3_scale(c->t1, c->rolling_impulse[0]), v3_scale(c->t2, c->rolling_impulse[1]));
+        vec3 L = v3_add(v3_scale(c->t1, c->x->rolling_impulse[0]), v3_scale(c->t2, c->x->rolling_impulse[1]));
         A->w = v3_sub(A->w, m3_mulv(A->inv_inertia, L));
         B->w = v3_add(B->w, m3_mulv(B->inv_inertia, L));
     }
@@ -149,10 +156,13 @@ SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx,
     int soft = ctx->correction == CAROM_CORRECTION_SOFT;
     int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
     const int count = c->count;
+    vec3 lock_a = v3_zero(), lock_b = v3_zero();
+    if (locked) { lock_a = c->x->lock_a; lock_b = c->x->lock_b; }
     for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
+        const constraint_rows *r = &c->r[i];
         /* current separation: small-angle update of the anchors */
-        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, p->rb_n) - v3_dot(dqa, p->ra_n);
+        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, r->rb_n) - v3_dot(dqa, r->ra_n);
         double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
         if (s > 0.0) {
             bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
@@ -164,42 +174,42 @@ SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx,
                 impulse_scale = c->soft.impulse_scale;
             }
         }
-        double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, p->rb_n) - v3_dot(wA, p->ra_n);
-        double lambda = -p->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
+        double vn = v3_dot(n, v3_sub(vB, vA)) + v3_dot(wB, r->rb_n) - v3_dot(wA, r->ra_n);
+        double lambda = -r->normal_mass * mass_scale * (vn + bias) - impulse_scale * p->normal_impulse;
         double total = p->normal_impulse + lambda;
         if (total < 0.0) total = 0.0;
         if (hold_bounces && s > 0.0 && c->restitution > 0.0 && total > p->normal_impulse) total = p->normal_impulse;
         lambda = total - p->normal_impulse;
         p->normal_impulse = total;
         p->total_normal_impulse += lambda;
-        if (total > p->max_normal_impulse) p->max_normal_impulse = total;
         vA = v3_madd(vA, -mA * lambda, n);
-        wA = v3_madd(wA, -lambda, p->ia_n);
+        wA = v3_madd(wA, -lambda, r->ia_n);
         vB = v3_madd(vB, mB * lambda, n);
-        wB = v3_madd(wB, lambda, p->ib_n);
-        if (locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
+        wB = v3_madd(wB, lambda, r->ib_n);
+        if (locked) { vA = keep_in_plane(vA, lock_a); vB = keep_in_plane(vB, lock_b); }
     }
     if (ctx->friction && c->friction > 0) {
         vec3 dv = v3_sub(vB, vA);
         for (int i = 0; i < count; i++) {
             constraint_point *p = &c->p[i];
+            const constraint_rows *r = &c->r[i];
             double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-            double v1 = v3_dot(dv, c->t1) + v3_dot(wB, p->rb_t[0]) - v3_dot(wA, p->ra_t[0]);
-            double v2 = v3_dot(dv, c->t2) + v3_dot(wB, p->rb_t[1]) - v3_dot(wA, p->ra_t[1]);
-            double n1 = o1 - p->tangent_mass[0] * v1;
-            double n2 = o2 - p->tangent_mass[1] * v2;
+            double v1 = v3_dot(dv, c->t1) + v3_dot(wB, r->rb_t[0]) - v3_dot(wA, r->ra_t[0]);
+            double v2 = v3_dot(dv, c->t2) + v3_dot(wB, r->rb_t[1]) - v3_dot(wA, r->ra_t[1]);
+            double n1 = o1 - r->tangent_mass[0] * v1;
+            double n2 = o2 - r->tangent_mass[1] * v2;
             double limit = c->friction * p->normal_impulse;
             if (n1 * n1 + n2 * n2 > limit * limit)
-                coulomb_over_cone(&n1, &n2, o1, o2, v1, v2, p->tangent_mass[0], p->tangent_mass[1], limit);
+                coulomb_over_cone(&n1, &n2, o1, o2, v1, v2, r->tangent_mass[0], r->tangent_mass[1], limit);
             p->tangent_impulse[0] = n1;
             p->tangent_impulse[1] = n2;
             double d1 = n1 - o1, d2 = n2 - o2;
             vec3 P = v3_add(v3_scale(c->t1, d1), v3_scale(c->t2, d2));
             vA = v3_madd(vA, -mA, P);
             vB = v3_madd(vB, mB, P);
-            wA = v3_sub(wA, v3_add(v3_scale(p->ia_t[0], d1), v3_scale(p->ia_t[1], d2)));
-            wB = v3_add(wB, v3_add(v3_scale(p->ib_t[0], d1), v3_scale(p->ib_t[1], d2)));
-            if (locked) { vA = keep_in_plane(vA, c->lock_a); vB = keep_in_plane(vB, c->lock_b); }
+            wA = v3_sub(wA, v3_add(v3_scale(r->ia_t[0], d1), v3_scale(r->ia_t[1], d2)));
+            wB = v3_add(wB, v3_add(v3_scale(r->ib_t[0], d1), v3_scale(r->ib_t[1], d2)));
+            if (locked) { vA = keep_in_plane(vA, lock_a); vB = keep_in_plane(vB, lock_b); }
             dv = v3_sub(vB, vA);
         }
     }
@@ -227,15 +237,17 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
     vec3 dpab = v3_sub(ctx->dp[c->b], ctx->dp[c->a]);
     int soft = ctx->correction == CAROM_CORRECTION_SOFT;
     int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
+    vec3 lock_a = constraint_lock_a(c), lock_b = constraint_lock_b(c);
+    double shock_normal[MANIFOLD_MAX_POINTS]; /* this pass's normal impulses, never warm-started */
     for (int i = 0; i < c->count; i++) {
         constraint_point *p = &c->p[i];
         /* rows from the anchors: a wide-solved point keeps only those */
         vec3 ra_n = v3_cross(p->ra, n), rb_n = v3_cross(p->rb, n);
         vec3 ia_n = m3_mulv(A->inv_inertia, ra_n), ib_n = m3_mulv(B->inv_inertia, rb_n);
         double s = p->base_separation + v3_dot(n, dpab) + v3_dot(ctx->dq[c->b], rb_n) - v3_dot(ctx->dq[c->a], ra_n);
-        double k = fa * (locked_inv_mass(A->inv_mass, n, c->lock_a) + v3_dot(ra_n, ia_n)) +
-                   fb * (locked_inv_mass(B->inv_mass, n, c->lock_b) + v3_dot(rb_n, ib_n));
-        p->shock_normal = 0.0;
+        double k = fa * (locked_inv_mass(A->inv_mass, n, lock_a) + v3_dot(ra_n, ia_n)) +
+                   fb * (locked_inv_mass(B->inv_mass, n, lock_b) + v3_dot(rb_n, ib_n));
+        shock_normal[i] = 0.0;
         if (k <= 0) continue;
         /* rigid against an immovable lower body, with the soft push-out rate */
         double bias = 0.0;
@@ -247,13 +259,13 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         /* the pass may pull back at most what the regular solve pushed */
         double lambda = dmax(-(vn + bias) / k, -p->normal_impulse);
         if (hold_bounces && s > 0.0 && c->restitution > 0.0 && lambda > 0.0) lambda = 0.0;
-        p->shock_normal = lambda;
+        shock_normal[i] = lambda;
         p->total_normal_impulse += lambda;
         A->v = v3_madd(A->v, -fa * A->inv_mass * lambda, n);
         A->w = v3_madd(A->w, -fa * lambda, ia_n);
         B->v = v3_madd(B->v, fb * B->inv_mass * lambda, n);
         B->w = v3_madd(B->w, fb * lambda, ib_n);
-        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+        if (c->locked) { A->v = keep_in_plane(A->v, lock_a); B->v = keep_in_plane(B->v, lock_b); }
     }
     if (!ctx->friction || c->friction <= 0) return;
     for (int i = 0; i < c->count; i++) {
@@ -263,19 +275,19 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         double nw[2];
         for (int j = 0; j < 2; j++) {
             vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
-            double k = fa * (locked_inv_mass(A->inv_mass, t[j], c->lock_a) + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
-                       fb * (locked_inv_mass(B->inv_mass, t[j], c->lock_b) + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
+            double k = fa * (locked_inv_mass(A->inv_mass, t[j], lock_a) + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
+                       fb * (locked_inv_mass(B->inv_mass, t[j], lock_b) + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
             nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
         }
         /* Coulomb on the total: what the regular pass used plus this pass */
         double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
         double t1 = o1 + nw[0], t2 = o2 + nw[1];
-        coulomb_clamp(&t1, &t2, c->friction * dmax(p->normal_impulse + p->shock_normal, 0.0));
+        coulomb_clamp(&t1, &t2, c->friction * dmax(p->normal_impulse + shock_normal[i], 0.0));
         vec3 P = v3_add(v3_scale(t[0], t1 - o1), v3_scale(t[1], t2 - o2));
         A->v = v3_madd(A->v, -fa * A->inv_mass, P);
         A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
         B->v = v3_madd(B->v, fb * B->inv_mass, P);
         B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(p->rb, P)), fb));
-        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+        if (c->locked) { A->v = keep_in_plane(A->v, lock_a); B->v = keep_in_plane(B->v, lock_b); }
     }
 }

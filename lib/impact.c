@@ -139,8 +139,8 @@ static void pair_geometry(carom_world *w, const contact_constraint *cc, const im
         ip->rb[j] = v3_sub(m.points[j].point, cb);
         /* a plane-locked body moves along the normal only by its part in the plane */
         double k = impulse_inverse_effective_mass(B, A, ip->rb[j], ip->ra[j], m.normal) -
-                   (A->inv_mass - locked_inv_mass(A->inv_mass, m.normal, c->lock_a)) -
-                   (B->inv_mass - locked_inv_mass(B->inv_mass, m.normal, c->lock_b));
+                   (A->inv_mass - locked_inv_mass(A->inv_mass, m.normal, constraint_lock_a(c))) -
+                   (B->inv_mass - locked_inv_mass(B->inv_mass, m.normal, constraint_lock_b(c)));
         ip->normal_mass[j] = k > 0.0 ? 1.0 / k : 0.0;
     }
 }
@@ -181,14 +181,17 @@ static int pair_collide(carom_world *w, const contact_constraint *cc, impact_bod
             double d = total - lambda[j];
             lambda[j] = total;
             impulse_apply(B, A, ip->rb[j], ip->ra[j], v3_scale(ip->n, d));
-            if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+            if (c->locked) {
+                A->v = keep_in_plane(A->v, constraint_lock_a(c));
+                B->v = keep_in_plane(B->v, constraint_lock_b(c));
+            }
         }
     for (int j = 0; j < ip->count; j++) {
         ip->impulse += lambda[j];
         if (ip->mu > 0.0 && lambda[j] > 0.0)
             impulse_apply(B, A, ip->rb[j], ip->ra[j],
                           impulse_friction(B, A, ip->rb[j], ip->ra[j], ip->n, ip->mu, lambda[j], NULL));
-        if (c->locked) { A->v = keep_in_plane(A->v, c->lock_a); B->v = keep_in_plane(B->v, c->lock_b); }
+        if (c->locked) { A->v = keep_in_plane(A->v, constraint_lock_a(c)); B->v = keep_in_plane(B->v, constraint_lock_b(c)); }
     }
     /* what each body would not have travelled before the impact */
     double back = tau * dt;
@@ -249,7 +252,6 @@ int impact_resolve(carom_world *w, contact_constraint *cc, int ncon, int nb, dou
         if (pairs[i].impulse <= 0.0) continue;
         constraint_point *p = &cc[pairs[i].con].p[0];
         p->total_normal_impulse += pairs[i].impulse;
-        if (pairs[i].impulse > p->max_normal_impulse) p->max_normal_impulse = pairs[i].impulse;
     }
     s->impact.bodies = nb;
     return 1;

@@ -39,15 +39,15 @@
  * refuse from this fraction of the bound */
 #define PENALTY_EXPLICIT_MARGIN 0.8
 
-void penalty_prepare_point(constraint_point *p, const step_context *ctx)
+void penalty_prepare_point(constraint_point *p, const constraint_rows *r, penalty_spring *sp, const step_context *ctx)
 {
     double omega = PENALTY_TWO_PI * ctx->contact_hertz;
     if (ctx->penalty_implicit) omega *= PENALTY_IMPLICIT_HERTZ_SCALE;
     /* the automatic explicit spring (critically damped) stays stable:
      * h^2 w^2 + 4 h w < 4 * 0.8 at h w <= 0.6 */
     else if (omega * ctx->h > 0.6) omega = 0.6 / ctx->h;
-    p->penalty_k = ctx->penalty_stiffness > 0 ? ctx->penalty_stiffness : p->normal_mass * omega * omega;
-    p->penalty_c = ctx->penalty_damping > 0 ? ctx->penalty_damping : 2.0 * p->normal_mass * omega;
+    sp->k = ctx->penalty_stiffness > 0 ? ctx->penalty_stiffness : r->normal_mass * omega * omega;
+    sp->c = ctx->penalty_damping > 0 ? ctx->penalty_damping : 2.0 * r->normal_mass * omega;
     if (!ctx->penalty_implicit) {
         p->normal_impulse = 0.0;
         p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
@@ -67,26 +67,28 @@ int penalty_check(const step_context *ctx, char *msg, size_t msg_size)
     if (ctx->penalty_implicit) return 1;
     for (int k = 0; k < n; k++)
         for (int i = 0; i < cc[k].count; i++) {
-            const constraint_point *p = &cc[k].p[i];
-            double r = penalty_explicit_stability(p->penalty_k, p->penalty_c, p->normal_mass, h);
+            const constraint_rows *rows = &cc[k].r[i];
+            const penalty_spring *sp = &cc[k].spring[i];
+            double r = penalty_explicit_stability(sp->k, sp->c, rows->normal_mass, h);
             if (r >= PENALTY_EXPLICIT_MARGIN) {
                 snprintf(msg, msg_size,
                            "explicit penalty spring k %g N/m, c %g N s/m on effective mass %g kg is "
                            "unstable at sub-step %g s (h^2 k/m + 2 h c/m = %.3g >= %.3g): use penalty_implicit = 1, "
                            "a smaller penalty_stiffness or more substeps",
-                           p->penalty_k, p->penalty_c, p->normal_mass, h, 4.0 * r, 4.0 * PENALTY_EXPLICIT_MARGIN);
+                           sp->k, sp->c, rows->normal_mass, h, 4.0 * r, 4.0 * PENALTY_EXPLICIT_MARGIN);
                 return 0;
             }
         }
     return 1;
 }
 
-static void friction_rows(impulse_body *A, impulse_body *B, contact_constraint *c, constraint_point *p)
+static void friction_rows(impulse_body *A, impulse_body *B, contact_constraint *c, constraint_point *p,
+                          const constraint_rows *r)
 {
     vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
     double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-    double l1 = o1 - p->tangent_mass[0] * v3_dot(vp, c->t1);
-    double l2 = o2 - p->tangent_mass[1] * v3_dot(vp, c->t2);
+    double l1 = o1 - r->tangent_mass[0] * v3_dot(vp, c->t1);
+    double l2 = o2 - r->tangent_mass[1] * v3_dot(vp, c->t2);
     coulomb_clamp(&l1, &l2, c->friction * p->normal_impulse);
     p->tangent_impulse[0] = l1;
     p->tangent_impulse[1] = l2;
@@ -137,16 +139,17 @@ void penalty_solve(const step_context *ctx)
             vec3 dpab = v3_sub(dp[c->b], dp[c->a]);
             for (int i = 0; i < c->count; i++) {
                 constraint_point *p = &c->p[i];
-                if (p->normal_mass <= 0.0) continue;
-                double s = p->base_separation + v3_dot(c->n, dpab) + v3_dot(dq[c->b], p->rb_n) - v3_dot(dq[c->a], p->ra_n);
+                const constraint_rows *r = &c->r[i];
+                if (r->normal_mass <= 0.0) continue;
+                double s = p->base_separation + v3_dot(c->n, dpab) + v3_dot(dq[c->b], r->rb_n) - v3_dot(dq[c->a], r->ra_n);
                 double total = 0.0; /* apart: no spring (a warm impulse is taken back) */
                 if (s < 0.0) {
                     double vn = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
-                    double kk = p->penalty_k, cd = p->penalty_c;
+                    double kk = c->spring[i].k, cd = c->spring[i].c;
                     if (implicit) {
                         /* P = -h (k (s + h vn') + c vn') with vn' = vn + dP / m_eff: the
                          * correction dP of this point's accumulated impulse */
-                        double inv_m = 1.0 / p->normal_mass, g = h * (h * kk + cd);
+                        double inv_m = 1.0 / r->normal_mass, g = h * (h * kk + cd);
                         double residual = p->normal_impulse + h * kk * s + g * vn;
                         total = p->normal_impulse - residual / (1.0 + g * inv_m);
                     } else {
@@ -158,10 +161,9 @@ void penalty_solve(const step_context *ctx)
                 if (d == 0.0 && total == 0.0 && p->tangent_impulse[0] == 0.0 && p->tangent_impulse[1] == 0.0) continue;
                 p->normal_impulse = total;
                 p->total_normal_impulse += d;
-                if (total > p->max_normal_impulse) p->max_normal_impulse = total;
                 impulse_apply(B, A, p->rb, p->ra, v3_scale(c->n, d));
                 /* Coulomb friction on this sub-step's spring impulse */
-                if (friction_on && c->friction > 0.0) friction_rows(A, B, c, p);
+                if (friction_on && c->friction > 0.0) friction_rows(A, B, c, p, r);
                 else if (total == 0.0) drop_friction(A, B, c, p);
                 if (total > largest) largest = total;
                 if (fabs(d) > change) change = fabs(d);

@@ -272,10 +272,12 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->warm = cd->state;
     c->center_a = bs->center[sa];
     c->center_b = bs->center[sb];
-    c->lock_a = c->lock_b = v3_zero();
-    if (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE)) c->lock_a = bs->plane_normal[sa];
-    if (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE)) c->lock_b = bs->plane_normal[sb];
-    c->locked = v3_len2(c->lock_a) > 0.0 || v3_len2(c->lock_b) > 0.0;
+    /* plane normals (attach_extras): a moving body's, when it is locked to a plane */
+    c->locked = (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
+                (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
+    c->r = NULL;
+    c->spring = NULL;
+    c->x = NULL;
     if (touching_impact(c, &bodies[c->a], &bodies[c->b], c->center_a, c->center_b, ctx->push_max)) {
         /* a touching pair driven together faster than the soft contact may
          * push out is stopped rigidly, as a speculative contact would be: a
@@ -464,6 +466,28 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     return 1;
 }
 
+/* The few manifolds with a plane-locked body or rolling resistance get
+ * their extra fields (constraint_extra), in constraint order. */
+static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon)
+{
+    solver_memory *sm = &w->scratch.solver;
+    const body_store *bs = &w->bodies;
+    int n = 0;
+    for (int k = 0; k < ncon; k++) n += cc[k].locked || cc[k].rolling > 0.0;
+    if (n == 0) return 1;
+    if (!array_reserve(&sm->extra, &sm->extra_capacity, n, sizeof(constraint_extra))) return 0;
+    constraint_extra *x = sm->extra;
+    for (int k = 0; k < ncon; k++) {
+        contact_constraint *c = &cc[k];
+        if (!c->locked && !(c->rolling > 0.0)) continue;
+        memset(x, 0, sizeof *x);
+        if (c->locked & 1) x->lock_a = bs->plane_normal[ctx->body_slot[c->a]];
+        if (c->locked & 2) x->lock_b = bs->plane_normal[ctx->body_slot[c->b]];
+        c->x = x++;
+    }
+    return 1;
+}
+
 static int build_constraints(carom_world *w, step_context *ctx, solver_work *work)
 {
     step_scratch *s = &w->scratch;
@@ -488,6 +512,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     }
     constraint_job job = {w, ctx, cc, NULL};
     tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
+    if (!attach_extras(w, ctx, cc, ncon)) return 0;
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
     for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;
     ctx->constraints = cc;
@@ -532,6 +557,31 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
 static contact_constraint *scalar_constraint(const step_context *ctx, const solver_work *work, int k)
 {
     return &ctx->constraints[work->scalar ? work->scalar[k] : k];
+}
+
+/* The rows of the manifolds the scalar passes take (and the penalty
+ * model's springs), packed in their order; a wide-solved manifold has its
+ * rows in its lanes only. */
+static int attach_rows(carom_world *w, const step_context *ctx, solver_work *work)
+{
+    solver_memory *sm = &w->scratch.solver;
+    int n = 0;
+    for (int k = 0; k < work->scalar_count; k++) n += scalar_constraint(ctx, work, k)->count;
+    if (n == 0) return 1;
+    if (!array_reserve(&sm->rows, &sm->rows_capacity, n, sizeof(constraint_rows))) return 0;
+    if (ctx->penalty && !array_reserve(&sm->springs, &sm->springs_capacity, n, sizeof(penalty_spring))) return 0;
+    constraint_rows *r = sm->rows;
+    penalty_spring *sp = sm->springs;
+    for (int k = 0; k < work->scalar_count; k++) {
+        contact_constraint *c = scalar_constraint(ctx, work, k);
+        c->r = r;
+        r += c->count;
+        if (ctx->penalty) {
+            c->spring = sp;
+            sp += c->count;
+        }
+    }
+    return 1;
 }
 
 /* A wide-solved manifold's rows go straight to its lane, and its scalar
@@ -860,6 +910,9 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
 void solver_memory_free(solver_memory *m)
 {
     free(m->block);
+    free(m->rows);
+    free(m->springs);
+    free(m->extra);
     free(m->wide);
     free(m->order);
     free(m->last_order);
@@ -873,7 +926,7 @@ int world_solve(carom_world *w, step_context *ctx)
     memset(&work, 0, sizeof work);
     if (!gather_bodies(w, ctx, &work) || !build_constraints(w, ctx, &work)) return 0;
     plan_shock(ctx, &work);
-    if (!plan_wide(w, ctx, &work)) return 0;
+    if (!plan_wide(w, ctx, &work) || !attach_rows(w, ctx, &work)) return 0;
     prepare_points(ctx, &work);
     if (!check_penalty(w, ctx)) return -1;
     if (!resolve_impacts(w, ctx, &work)) return 0;

@@ -9,6 +9,12 @@
 typedef struct solver_memory {
     void *block;                 /* constraints, their points, shock and contact lists */
     int block_capacity;
+    void *rows;                  /* the scalar passes' rows (constraint_rows) */
+    int rows_capacity;
+    void *springs;               /* the penalty model's springs (penalty_spring) */
+    int springs_capacity;
+    void *extra;                 /* locked and rolling manifolds' constraint_extra */
+    int extra_capacity;
     void *wide;                  /* solver_wide.c's batches */
     size_t wide_capacity;
     void *order;                 /* the manifolds' solve-order keys (sort_touching) */

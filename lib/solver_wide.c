@@ -41,7 +41,7 @@ typedef double lane_t[LANES];
 /* One point slot of a batch: lane l holds point i of the batch's l-th manifold. */
 typedef struct wide_point {
     lane_t base_separation, normal_mass, normal_impulse;
-    lane_t total_normal_impulse, max_normal_impulse;
+    lane_t total_normal_impulse;
     lane_t ra_n[3], rb_n[3], ia_n[3], ib_n[3];
     lane_t tangent_mass[2], tangent_impulse[2];
     lane_t ra_t[2][3], rb_t[2][3], ia_t[2][3], ib_t[2][3];
@@ -377,8 +377,6 @@ LANE_INLINE void solve_normal_rows(const wide_batch *wb, wide_point *pts, const 
         lane_t lambda = total - old;
         p->normal_impulse = total;
         p->total_normal_impulse += lambda;
-        lane_t most = p->max_normal_impulse;
-        p->max_normal_impulse = LANE_MAX(most, total);
         lane_t la = lb->ma * lambda, lbm = lb->mb * lambda;
         for (int d = 0; d < 3; d++) {
             lb->va[d] -= la * wb->n[d];
@@ -552,12 +550,12 @@ LANE_INLINE void warm_point(wide_point *p, const contact_point_state *const st[L
     p->tangent_impulse[0] = warm_scale * t1;
     p->tangent_impulse[1] = warm_scale * t2;
     p->total_normal_impulse = zero;
-    p->max_normal_impulse = zero;
 }
 
-/* The scalar copy of point i in each lane's constraint (restitution, impulse
- * storage and the overflow passes read it); returns the deepest penetration. */
-LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, const wide_point *p, int i,
+/* What the stages around the passes read of point i in each lane's
+ * constraint (the shock pass, restitution, the events); returns the deepest
+ * penetration. */
+LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, int i,
                                const lane_t ra[3], const lane_t rb[3], const lane_t *sep, const lane_t *vn,
                                double deepest)
 {
@@ -569,9 +567,6 @@ LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, c
         cold->total_normal_impulse = 0.0;
         cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
         cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
-        cold->normal_mass = p->normal_mass[l];
-        cold->tangent_mass[0] = p->tangent_mass[0][l];
-        cold->tangent_mass[1] = p->tangent_mass[1][l];
         if (-s > deepest) deepest = -s;
     }
     return deepest;
@@ -611,7 +606,7 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
         for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
         lane_t vn = DOT3(vrel, wb->n);
         warm_point(p, st, warm);
-        deepest = store_point(wb, &lm, p, i, ra, rb, &sep, &vn, deepest);
+        deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
     }
     return deepest;
 }
@@ -772,7 +767,6 @@ void wide_store(const wide_set *ws, contact_constraint *cc)
                 constraint_point *p = &c->p[i];
                 p->normal_impulse = q->normal_impulse[l];
                 p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */
-                p->max_normal_impulse = q->max_normal_impulse[l];
                 p->tangent_impulse[0] = q->tangent_impulse[0][l];
                 p->tangent_impulse[1] = q->tangent_impulse[1][l];
             }
