@@ -3,10 +3,11 @@
  * time of carom_world_snapshot and carom_world_restore over 9 runs each.
  * The pile is two layers, the upper one offset by half a cell so its bodies
  * fall into the gaps of the lower (taller drops of mixed shapes keep
- * avalanching for minutes). Measured: 1,250 bodies (25 x 25 x 2) sleep by
- * step ~450; 10,000 (71 x 71 x 2) did NOT settle, 9,780 awake after 2,400
- * steps (at 13:04 on 2026-12-02), so the printed figure is still not of a
- * settled pile. Round bodies need rolling resistance
+ * avalanching for minutes), in heaps of 25 x 25 x 2 = 1,250 bodies 2.5 m
+ * apart: one heap sleeps by step ~440, but one 71 x 71 x 2 pile of 10,000
+ * is one island and did NOT settle (9,895 awake after 2,400 steps, 774
+ * B/body), so 10,000 bodies are eight heaps, each its own island (all
+ * asleep at step 440: 629 B/body). Round bodies need rolling resistance
  * to stop rolling (0.2: a ball slows at 0.2 g), and a sphere resting on
  * others keeps a slow spin about the vertical that friction cannot take
  * away, so islands sleep below 0.2 rad/s (surface speed 4 cm/s at r 0.2 m)
@@ -50,15 +51,19 @@ static carom_world *settled_pile(int n)
                                       carom_shape_hull(tetra, 5)};
     carom_material mat = carom_material_default();
     mat.rolling_resistance = 0.2;
+    /* heaps of at most 25 x 25 x 2 = 1,250 bodies, 14 m apart (2.5 m
+     * between them): each its own island, so each sleeps on its own */
     int side = 1; /* two layers of side x side */
-    while (2 * side * side < n) side++;
+    while (2 * side * side < n && side < 25) side++;
+    int per_heap = 2 * side * side;
     for (int i = 0; i < n; i++) {
         carom_body_def b = carom_body_def_default();
         b.shape = shapes[i % 5];
         b.material = &mat;
-        int layer = i / (side * side), offset = layer % 2;
-        b.position.x = 0.45 * (i % side) + 0.02 * (i / side % 3) + 0.225 * offset;
-        b.position.y = 0.45 * (i / side % side) + 0.225 * offset;
+        int heap = i / per_heap, j = i % per_heap;
+        int layer = j / (side * side), offset = layer % 2;
+        b.position.x = 14.0 * (heap % 3) + 0.45 * (j % side) + 0.02 * (j / side % 3) + 0.225 * offset;
+        b.position.y = 14.0 * (heap / 3) + 0.45 * (j / side % side) + 0.225 * offset;
         b.position.z = 0.25 + 0.45 * layer;
         carom_body_create(w, &b);
     }
