@@ -120,10 +120,48 @@ int contact_add(contact_set *cs, int a, int b) { return contact_add_sub(cs, a, b
 
 int contact_set_reserve(contact_set *cs, int n)
 {
+    if (cs->map.count == 0 && (n + 1) * 2 > cs->map.capacity) { /* empty: the same capacity at once */
+        int capacity = cs->map.capacity;
+        while ((n + 1) * 2 > capacity) capacity *= 2;
+        pair_map m;
+        if (!map_init(&m, capacity)) {
+            free(m.keys);
+            free(m.subs);
+            free(m.values);
+            return 0;
+        }
+        free(cs->map.keys);
+        free(cs->map.subs);
+        free(cs->map.values);
+        cs->map = m;
+    }
     while ((n + 1) * 2 > cs->map.capacity)
         if (!map_grow(&cs->map)) return 0;
     return array_reserve((void **)&cs->items, &cs->capacity, n, sizeof *cs->items) &&
            array_reserve((void **)&cs->data, &cs->data_capacity, n, sizeof *cs->data);
+}
+
+int contact_add_new_sub(contact_set *cs, int a, int b, uint32_t sub)
+{
+    if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
+    uint64_t key = pair_key(a, b);
+    int slot = map_slot(&cs->map, key, sub);
+    if (cs->map.keys[slot] == key) return -2;
+    if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
+    if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->count + 1, sizeof *cs->data)) return -1;
+    int i = cs->count++;
+    contact *c = &cs->items[i];
+    memset(c, 0, sizeof *c);
+    memset(&cs->data[i], 0, sizeof cs->data[i]);
+    c->id_a = a < b ? a : b;
+    c->id_b = a < b ? b : a;
+    c->cache.feature = -1;
+    c->sub = sub;
+    cs->map.keys[slot] = key; /* where map_put would put it: one probe */
+    cs->map.subs[slot] = sub;
+    cs->map.values[slot] = i;
+    cs->map.count++;
+    return i;
 }
 
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)

@@ -79,6 +79,9 @@ int contact_set_reserve(contact_set *cs, int n);
 /* The same for a pair's extra manifold number sub (> 0). */
 int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub);
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub);
+/* contact_add_sub for a pair and sub not yet in the set (one map probe):
+ * -2 when it is there already, -1 on out of memory. */
+int contact_add_new_sub(contact_set *cs, int a, int b, uint32_t sub);
 /* Swap-removes contact i. */
 void contact_remove(contact_set *cs, int i);
 /* Carries warm-start impulses from the old manifold to the new one. */

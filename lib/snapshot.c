@@ -297,79 +297,82 @@ static int coded_tag(uint64_t x)
     return 8 - lead;                                 /* keep the low 8 - lead bytes */
 }
 
+/* A tag's payload length: 1..8 low bytes, 9..15 the high 16 - tag bytes. */
+static const unsigned char coded_len[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 7, 6, 5, 4, 3, 2, 1};
+
 static void put_coded(writer *o, const double *v, const double *pred, int n)
 {
     uint64_t x[CODED_MAX];
     int tag[CODED_MAX];
+    size_t len = (size_t)(n + 1) / 2;
     for (int i = 0; i < n; i++) {
         x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
         tag[i] = coded_tag(x[i]);
+        len += coded_len[tag[i]];
     }
-    size_t len = (size_t)(n + 1) / 2;
-    for (int i = 0; i < n; i++) len += (size_t)(tag[i] <= 8 ? tag[i] : 16 - tag[i]);
     if (o->pos + len > o->cap) { /* measuring, or out of room: only the size */
         o->pos += len;
         return;
     }
-    /* built here with whole 8-byte stores (each value's bytes, then bytes the
-     * next one overwrites), then copied: the caller's buffer is written only
-     * up to the snapshot's size */
-    unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX + 8], *b = bytes;
+    /* whole 8-byte stores (each value's bytes, then bytes the next one
+     * overwrites) straight into the buffer when 8 bytes past the end fit
+     * in it, else into a copy: the caller's buffer is written only up to
+     * the snapshot's size */
+    unsigned char bytes[CODED_MAX / 2 + 1 + 8 * CODED_MAX + 8];
+    int direct = SNAP_HOST_LE && o->pos + len + 8 <= o->cap;
+    unsigned char *b = direct ? o->buf + o->pos : bytes;
     for (int i = 0; i < n; i += 2) *b++ = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
     for (int i = 0; i < n; i++) {
-        int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
         if (SNAP_HOST_LE) {
-            uint64_t v = x[i] >> (8 * from);
-            memcpy(b, &v, 8);
-            b += to - from;
+            uint64_t u = tag[i] <= 8 ? x[i] : x[i] >> (8 * (tag[i] - 8));
+            memcpy(b, &u, 8);
+            b += coded_len[tag[i]];
         } else {
+            int from = tag[i] <= 8 ? 0 : tag[i] - 8, to = tag[i] <= 8 ? tag[i] : 8;
             for (int k = from; k < to; k++) *b++ = (unsigned char)(x[i] >> (8 * k));
         }
     }
-    memcpy(o->buf + o->pos, bytes, len);
+    if (!direct) memcpy(o->buf + o->pos, bytes, len);
     o->pos += len;
 }
 
 /* The reader's side; every value decoded must be finite. */
 static void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
 {
-    int tag[CODED_MAX];
     size_t tags = (size_t)(n + 1) / 2;
-    for (int i = 0; i < n; i++) out[i] = 0;
-    if (!need(r, tags, what)) return;
-    const unsigned char *p = r->buf + r->pos;
-    for (int i = 0; i < n; i += 2) {
-        unsigned b = p[i / 2];
-        tag[i] = (int)(b & 15);
-        if (i + 1 < n) tag[i + 1] = (int)(b >> 4);
-        else if (b >> 4) { bad(r, "%s: unused tag bits set", what); return; }
+    if (!need(r, tags, what)) {
+        for (int i = 0; i < n; i++) out[i] = 0;
+        return;
     }
-    r->pos += tags;
-    int len[CODED_MAX];
+    const unsigned char *t = r->buf + r->pos;
     size_t total = 0;
-    for (int i = 0; i < n; i++) {
-        len[i] = tag[i] <= 8 ? tag[i] : 16 - tag[i];
-        total += (size_t)len[i];
+    for (int i = 0; i < n; i++) total += coded_len[(t[i >> 1] >> (4 * (i & 1))) & 15];
+    if ((n & 1) && (t[n >> 1] >> 4)) { bad(r, "%s: unused tag bits set", what); total = 0; }
+    r->pos += tags;
+    if (!need(r, total, what)) {
+        for (int i = 0; i < n; i++) out[i] = 0;
+        return;
     }
-    if (!need(r, total, what)) return;
-    p = r->buf + r->pos;
+    const unsigned char *p = r->buf + r->pos, *end = r->buf + r->size;
     r->pos += total;
-    const unsigned char *end = r->buf + r->size;
     for (int i = 0; i < n; i++) {
+        int tag = (t[i >> 1] >> (4 * (i & 1))) & 15, len = coded_len[tag];
         uint64_t x = 0;
         if (SNAP_HOST_LE && end - p >= 8) { /* one load, the value's bytes kept */
             memcpy(&x, p, 8);
-            if (len[i] < 8) x &= ((uint64_t)1 << (8 * len[i])) - 1;
+            if (len < 8) x &= ((uint64_t)1 << (8 * len)) - 1;
         } else {
-            for (int k = 0; k < len[i]; k++) x |= (uint64_t)p[k] << (8 * k);
+            for (int k = 0; k < len; k++) x |= (uint64_t)p[k] << (8 * k);
         }
-        if (tag[i] > 8) x <<= 8 * (tag[i] - 8);
-        p += len[i];
-        if (coded_tag(x) != tag[i]) { bad(r, "%s: a coded double not in its shortest form", what); return; }
+        if (tag > 8) x <<= 8 * (tag - 8);
+        p += len;
         uint64_t bits = x ^ f64_bits(pred[i]);
-        if (((bits >> 52) & 0x7ff) == 0x7ff) { bad(r, "%s is not finite", what); return; }
         memcpy(&out[i], &bits, 8);
+        if (coded_tag(x) != tag) { bad(r, "%s: a coded double not in its shortest form", what); break; }
+        if (((bits >> 52) & 0x7ff) == 0x7ff) { bad(r, "%s is not finite", what); break; }
     }
+    if (r->failed)
+        for (int i = 0; i < n; i++) out[i] = 0;
 }
 
 static void put_coded_v3(writer *o, vec3 v, vec3 pred)
@@ -1054,11 +1057,10 @@ typedef struct reuse_motion {
     vec3 t;
 } reuse_motion;
 
-static reuse_motion reuse_guess(const contact *c, xform xa, xform xb)
+static reuse_motion reuse_guess(const contact *c, xform now)
 {
     reuse_motion m = {0, m3_zero(), v3(0, 0, 0)};
     if (!(c->flags & CONTACT_REUSABLE)) return m;
-    xform now = relative_pose(xa, xb);
     quat dq = q_mul(now.q, q_conj(c->rel_pose.q));
     m.on = 1;
     m.R = m3_from_quat(dq);
@@ -1109,12 +1111,37 @@ typedef struct contact_guess {
     double material[3]; /* friction, restitution, rolling resistance as material.c mixes them */
 } contact_guess;
 
-static contact_guess guess_contact(const body_store *s, const xform *pose, int a, int b, uint32_t sub)
+/* material_mix depends on the two bodies' classes alone for a pair's first
+ * manifold (sub 0): mixed once per pair of classes (the same bits). */
+#define MIX_MEMO_CLASSES 32
+typedef struct mix_memo {
+    const int *class_of;    /* per slot */
+    double mix[MIX_MEMO_CLASSES * MIX_MEMO_CLASSES][3];
+    unsigned char have[MIX_MEMO_CLASSES * MIX_MEMO_CLASSES];
+} mix_memo;
+
+static void mix_memo_init(mix_memo *m, const int *class_of)
+{
+    m->class_of = class_of;
+    memset(m->have, 0, sizeof m->have);
+}
+
+static contact_guess guess_contact(const body_store *s, mix_memo *memo, const xform *pose, int a, int b, uint32_t sub)
 {
     contact_guess g;
     g.xa = pose[a];
     g.xb = pose[b];
-    material_mix(s, a, b, sub, g.material);
+    int ka = memo ? memo->class_of[a] : MIX_MEMO_CLASSES, kb = memo ? memo->class_of[b] : MIX_MEMO_CLASSES;
+    if (sub == 0 && ka < MIX_MEMO_CLASSES && kb < MIX_MEMO_CLASSES) {
+        int k = ka * MIX_MEMO_CLASSES + kb;
+        if (!memo->have[k]) {
+            material_mix(s, a, b, 0, memo->mix[k]);
+            memo->have[k] = 1;
+        }
+        memcpy(g.material, memo->mix[k], sizeof g.material);
+    } else {
+        material_mix(s, a, b, sub, g.material);
+    }
     return g;
 }
 
@@ -1137,17 +1164,19 @@ static unsigned contact_bits(const contact *c, const contact_data *d, const cont
                         ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, &normal_a, sizeof normal_a) ? CREC_NORMAL_A : 0);
 }
 
-static void write_contacts(writer *o, const carom_world *w)
+static void write_contacts(writer *o, const carom_world *w, const class_table *t)
 {
     const body_store *s = &w->bodies;
     const contact_set *cs = &w->contacts;
+    mix_memo *memo = malloc(sizeof *memo); /* (without it, every contact mixes its own) */
+    if (memo) mix_memo_init(memo, t->of_body);
     put_varint(o, (uint64_t)cs->count);
     int last_a = 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         const contact_data *d = &cs->data[i];
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        contact_guess g = guess_contact(s, s->collided, a, b, c->sub);
+        contact_guess g = guess_contact(s, memo, s->collided, a, b, c->sub);
         /* what the reader will hold, and predict from */
         vec3 normal = normal_is_state(c, d) ? d->m.normal : v3(0, 0, 0);
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
@@ -1158,14 +1187,14 @@ static void write_contacts(writer *o, const carom_world *w)
         unsigned bits = contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a);
         /* every point where the reader predicts it (a settled pile's kept
          * manifolds): their positions and separations are not written */
-        reuse_motion m = reuse_guess(c, g.xa, g.xb);
+        reuse_motion m = reuse_guess(c, rel); /* (rel: B's collided pose in A's when posed) */
         int exact = d->m.count > 0;
-        for (int k = 0; k < d->m.count && exact; k++) {
-            vec3 point;
-            double separation;
-            point_guess(&m, d, g.xa, &d->state[k], &point, &separation);
-            exact = same_bits(&point, &d->m.points[k].point, sizeof point) &&
-                    f64_bits(separation) == f64_bits(d->m.points[k].separation);
+        vec3 guess_point[MANIFOLD_MAX_POINTS];
+        double guess_separation[MANIFOLD_MAX_POINTS];
+        for (int k = 0; k < d->m.count; k++) {
+            point_guess(&m, d, g.xa, &d->state[k], &guess_point[k], &guess_separation[k]);
+            exact = exact && same_bits(&guess_point[k], &d->m.points[k].point, sizeof(vec3)) &&
+                    f64_bits(guess_separation[k]) == f64_bits(d->m.points[k].separation);
         }
         if (exact) bits |= CREC_EXACT;
         size_t at = o->pos;
@@ -1221,9 +1250,6 @@ static void write_contacts(writer *o, const carom_world *w)
             const contact_point_state *st = &d->state[k];
             double cur[7] = {st->local_a.x, st->local_a.y, st->local_a.z, st->separation,
                              st->normal_impulse, st->tangent_impulse[0], st->tangent_impulse[1]};
-            vec3 point;
-            double separation;
-            point_guess(&m, d, g.xa, st, &point, &separation);
             at = o->pos;
             put_varint(o, p->id);
             acct(o, SNAP_FIELD_point_id, at);
@@ -1242,13 +1268,14 @@ static void write_contacts(writer *o, const carom_world *w)
             }
             if (!exact) {
                 size_t pw = o->pos;
-                put_coded_v3(o, p->point, point);
-                put_coded1(o, p->separation, separation);
+                put_coded_v3(o, p->point, guess_point[k]);
+                put_coded1(o, p->separation, guess_separation[k]);
                 acct(o, SNAP_FIELD_point_world, pw);
             }
             memcpy(last, cur, sizeof cur);
         }
     }
+    free(memo);
 }
 
 static void write_world(writer *o, const carom_world *w, const class_table *t, const xform *pose)
@@ -1269,7 +1296,7 @@ static void write_world(writer *o, const carom_world *w, const class_table *t, c
     }
     acct(o, SNAP_FIELD_ids, at);
     write_bodies(o, w, t, pose);
-    write_contacts(o, w);
+    write_contacts(o, w, t);
     /* the sensors' overlaps after the last step (sensor.c): their next events */
     at = o->pos;
     put_varint(o, (uint64_t)w->sensor_overlap_count);
@@ -1501,7 +1528,8 @@ static void body_label(char what[48], int i)
     what[5 + n] = '\0';
 }
 
-static int read_bodies(reader *r, carom_world *w)
+/* class_of: each body's class (the caller frees it, whatever the result) */
+static int read_bodies(reader *r, carom_world *w, int **class_of)
 {
     body_store *s = &w->bodies;
     if (!read_ids(r, s)) return 0;
@@ -1531,6 +1559,8 @@ static int read_bodies(reader *r, carom_world *w)
     s->free_id = free_id;
     if (!ok) { free(classes); return bad(r, "out of memory"); }
     if (!check_ids(r, s, count)) { free(classes); return 0; }
+    *class_of = malloc(sizeof **class_of * (size_t)(count > 0 ? count : 1));
+    if (!*class_of) { free(classes); return bad(r, "out of memory"); }
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
@@ -1544,6 +1574,7 @@ static int read_bodies(reader *r, carom_world *w)
         /* classes come in the order bodies first use them, each used */
         if (ci > classes_used) { bad(r, "body %d uses class %d before class %d", i, ci, classes_used); break; }
         if (ci == classes_used) classes_used++;
+        (*class_of)[i] = ci;
         const body_class *k = &classes[ci];
         if (k->type == CAROM_BODY_STATIC && (bits & REC_AWAKE)) { bad(r, "static body %d is awake", i); break; }
         s->type[i] = k->type;
@@ -1666,14 +1697,26 @@ static int read_sensor_overlaps(reader *r, carom_world *w)
     return 1;
 }
 
-static int read_contacts(reader *r, carom_world *w)
+static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *memo);
+
+static int read_contacts(reader *r, carom_world *w, const int *class_of)
 {
-    body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     int count = get_small(r, 0, 1 << 28, 0, "contact count");
     if (r->failed) return 0;
     if ((size_t)count * 4 > r->size - r->pos) return bad(r, "truncated: %d contacts need more than the bytes left", count);
     if (!contact_set_reserve(cs, count)) return bad(r, "out of memory");
+    mix_memo *memo = malloc(sizeof *memo); /* (without it, every contact mixes its own) */
+    if (memo) mix_memo_init(memo, class_of);
+    int ok = read_contact_list(r, w, count, memo);
+    free(memo);
+    return ok;
+}
+
+static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *memo)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
     int last_a = 0;
     for (int i = 0; i < count && !r->failed; i++) {
         int a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 2 - last_a, 1, "contact body");
@@ -1694,18 +1737,19 @@ static int read_contacts(reader *r, carom_world *w)
             ((bits & CREC_POSE) && !posed) || ((bits & CREC_REACH) && !(flags & CONTACT_APART)) ||
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
-        if ((sub ? contact_find_sub(cs, a, b, sub) : contact_find(cs, a, b)) >= 0)
-            return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", i, a, b, (unsigned)sub);
-        int ci = sub ? contact_add_sub(cs, a, b, sub) : contact_add(cs, a, b);
+        int ci = contact_add_new_sub(cs, a, b, sub);
+        if (ci == -2) return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", i, a, b, (unsigned)sub);
         if (ci < 0) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
-        int child_a, child_b; /* the compound children a manifold number names must exist (its material is theirs) */
-        compound_sub_children(&s->shapes[sa], &s->shapes[sb], sub, &child_a, &child_b);
-        if ((child_a >= 0 && child_a >= s->shapes[sa].compound->count) || (child_b >= 0 && child_b >= s->shapes[sb].compound->count))
-            return bad(r, "contact %d: manifold %u names a compound child the bodies do not have", i, (unsigned)sub);
-        contact_guess g = guess_contact(s, s->collided, sa, sb, sub);
+        if (sub) { /* the compound children a manifold number names must exist (its material is theirs); sub 0 names child 0 */
+            int child_a, child_b;
+            compound_sub_children(&s->shapes[sa], &s->shapes[sb], sub, &child_a, &child_b);
+            if ((child_a >= 0 && child_a >= s->shapes[sa].compound->count) || (child_b >= 0 && child_b >= s->shapes[sb].compound->count))
+                return bad(r, "contact %d: manifold %u names a compound child the bodies do not have", i, (unsigned)sub);
+        }
+        contact_guess g = guess_contact(s, memo, s->collided, sa, sb, sub);
         c->flags = flags;
         c->sub_limit = sub_limit;
         c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
@@ -1724,20 +1768,20 @@ static int read_contacts(reader *r, carom_world *w)
         d->restitution = material[1];
         d->rolling_resistance = material[2];
         d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis") : v3(0, 0, 0);
+        /* the predictions, as the writer made them */
+        xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
+        double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
+        vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
         if (posed) {
-            xform rel = relative_pose(g.xa, g.xb);
             c->rel_pose.p = (bits & CREC_POSE) ? get_coded_v3(r, rel.p, "contact pose") : rel.p;
             c->rel_pose.q = (bits & CREC_POSE) ? get_coded_q(r, rel.q, "contact pose") : rel.q;
         }
         if (flags & CONTACT_APART) {
-            double reach = shape_bounding_radius(&s->shapes[sb]);
             c->gap = get_coded1(r, 0.0, "contact gap");
             c->reach_b = (bits & CREC_REACH) ? get_coded1(r, reach, "contact reach") : reach;
         }
-        if (flags & CONTACT_REUSABLE) {
-            vec3 normal_a = q_inv_rotate(g.xa.q, normal);
+        if (flags & CONTACT_REUSABLE)
             d->normal_a = (bits & CREC_NORMAL_A) ? get_coded_v3(r, normal_a, "contact normal") : normal_a;
-        }
         if (r->failed) return 0;
         if (bad_direction(d->m.normal) || bad_direction(c->cache.normal) || bad_direction(d->tangent1) ||
             ((flags & CONTACT_REUSABLE) && bad_direction(d->normal_a)))
@@ -1745,19 +1789,14 @@ static int read_contacts(reader *r, carom_world *w)
         if (posed && (!within_cube(c->rel_pose.p, 2 * RANGE_STATE_COORDINATE_MAX) ||
                       !(q_len(c->rel_pose.q) >= 0.5 && q_len(c->rel_pose.q) <= 2.0)))
             return bad(r, "contact %d: the pose is beyond 2e18 m or its rotation not near unit", i);
-        {
-            xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
-            double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
-            vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
-            if ((contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) | (bits & CREC_EXACT)) != (unsigned)bits ||
-                ((bits & CREC_EXACT) && d->m.count == 0))
-                return bad(r, "contact %d: its record bits do not match its fields", i);
-        }
+        if ((contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) | (bits & CREC_EXACT)) != (unsigned)bits ||
+            ((bits & CREC_EXACT) && d->m.count == 0))
+            return bad(r, "contact %d: its record bits do not match its fields", i);
         if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
               d->rolling_resistance >= 0 && d->rolling_resistance <= RANGE_FRICTION_MAX))
             return bad(r, "contact %d material out of range", i);
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
-        reuse_motion m = reuse_guess(c, g.xa, g.xb);
+        reuse_motion m = reuse_guess(c, rel);
         int inexact = 0;
         for (int k = 0; k < d->m.count && !r->failed; k++) {
             manifold_point *p = &d->m.points[k];
@@ -1832,12 +1871,15 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     if (!w) return bad(&r, "out of memory"), NULL;
     w->def.body_capacity = capacity_hint;
     w->stats.step_count = (long long)steps;
-    if (!read_bodies(&r, w)) {
+    int *class_of = NULL;
+    if (!read_bodies(&r, w, &class_of)) {
+        free(class_of);
         carom_world_destroy(w);
         return NULL;
     }
     body_store *s = &w->bodies;
-    int ok = read_contacts(&r, w) && read_sensor_overlaps(&r, w);
+    int ok = read_contacts(&r, w, class_of) && read_sensor_overlaps(&r, w);
+    free(class_of);
     if (!ok) {
         carom_world_destroy(w);
         return NULL;
