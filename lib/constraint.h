@@ -9,17 +9,22 @@
 #include "contact.h"
 #include "step.h"
 
-/* A point as every manifold has it: what the stages around the passes read
- * (the shock pass, impacts, impulse storage, hit and force events). The
- * rows the scalar passes solve are in constraint_rows; a wide-solved
- * manifold's rows live only in its batch's lanes (solver_wide.c). */
+/* A point as every manifold has it: what the stages after the passes read
+ * (impacts, impulse storage, hit and force events). Its anchors are in
+ * constraint_anchor, the rows the scalar passes solve in constraint_rows; a
+ * wide-solved manifold's anchors and rows live only in its batch's lanes
+ * (solver_wide.c), and its anchors also here when the shock pass runs. */
 typedef struct constraint_point {
-    double base_separation;
     double normal_impulse, tangent_impulse[2];
     double total_normal_impulse;
     double relative_velocity;    /* normal velocity before solving (restitution, hit events) */
-    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
 } constraint_point;
+
+/* A point's separation and anchors: the scalar passes' and the shock pass's. */
+typedef struct constraint_anchor {
+    double base_separation;
+    vec3 ra, rb;                 /* anchors from each centre (world, fixed over the step) */
+} constraint_anchor;
 
 /* A scalar-solved point's rows (contact_solver.c, penalty.c), hot fields
  * first in the order the solve pass reads them: the normal row, then the
@@ -62,6 +67,7 @@ typedef struct contact_constraint {
     double rolling;              /* rolling resistance (0: no rolling rows, the manifold may go wide) */
     softness soft;
     constraint_point *p;         /* count points in the step's packed point array */
+    constraint_anchor *an;       /* their anchors: scalar passes, and every manifold when the shock pass runs; else NULL */
     constraint_rows *r;          /* their rows: scalar passes only (NULL for a wide-solved manifold) */
     penalty_spring *spring;      /* their springs: penalty model only, else NULL */
     constraint_extra *x;         /* locked or rolling manifolds only, else NULL */

@@ -74,17 +74,18 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
     for (int j = 0; j < c->count; j++) {
         const manifold_point *mp = &c->m->points[j];
         constraint_point *p = &c->p[j];
+        constraint_anchor *q = &c->an[j];
         constraint_rows *r = &c->r[j];
-        p->ra = v3_sub(mp->point, ca);
-        p->rb = v3_sub(mp->point, cb);
-        r->ra_n = v3_cross(p->ra, c->n);
-        r->rb_n = v3_cross(p->rb, c->n);
+        q->ra = v3_sub(mp->point, ca);
+        q->rb = v3_sub(mp->point, cb);
+        r->ra_n = v3_cross(q->ra, c->n);
+        r->rb_n = v3_cross(q->rb, c->n);
         r->ia_n = m3_mulv(A->inv_inertia, r->ra_n);
         r->ib_n = m3_mulv(B->inv_inertia, r->rb_n);
-        r->ra_t[0] = v3_cross(p->ra, c->t1);
-        r->rb_t[0] = v3_cross(p->rb, c->t1);
-        r->ra_t[1] = v3_cross(p->ra, c->t2);
-        r->rb_t[1] = v3_cross(p->rb, c->t2);
+        r->ra_t[0] = v3_cross(q->ra, c->t1);
+        r->rb_t[0] = v3_cross(q->rb, c->t1);
+        r->ra_t[1] = v3_cross(q->ra, c->t2);
+        r->rb_t[1] = v3_cross(q->rb, c->t2);
         for (int q = 0; q < 2; q++) {
             r->ia_t[q] = m3_mulv(A->inv_inertia, r->ra_t[q]);
             r->ib_t[q] = m3_mulv(B->inv_inertia, r->rb_t[q]);
@@ -97,8 +98,8 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         r->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
         r->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
         r->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
-        p->base_separation = mp->separation;
-        p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n),
+        q->base_separation = mp->separation;
+        p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, q->rb, q->ra, c->n),
                                                          c->gravity_closing, mp->separation);
         p->normal_impulse = ws * c->warm[j].normal_impulse;
         p->tangent_impulse[0] = ws * c->warm[j].tangent_impulse[0];
@@ -120,7 +121,7 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
                         v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
         p->total_normal_impulse += p->normal_impulse;
         /* seed convention: body 1 = B receives +P (n points from A to B) */
-        impulse_apply(B, A, p->rb, p->ra, P);
+        impulse_apply(B, A, c->an[i].rb, c->an[i].ra, P);
         if (c->locked) {
             A->v = keep_in_plane(A->v, constraint_lock_a(c));
             B->v = keep_in_plane(B->v, constraint_lock_b(c));
@@ -162,7 +163,7 @@ SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx,
         constraint_point *p = &c->p[i];
         const constraint_rows *r = &c->r[i];
         /* current separation: small-angle update of the anchors */
-        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(dqb, r->rb_n) - v3_dot(dqa, r->ra_n);
+        double s = c->an[i].base_separation + v3_dot(n, dpab) + v3_dot(dqb, r->rb_n) - v3_dot(dqa, r->ra_n);
         double bias = 0.0, mass_scale = 1.0, impulse_scale = 0.0;
         if (s > 0.0) {
             bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
@@ -241,10 +242,11 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
     double shock_normal[MANIFOLD_MAX_POINTS]; /* this pass's normal impulses, never warm-started */
     for (int i = 0; i < c->count; i++) {
         constraint_point *p = &c->p[i];
+        const constraint_anchor *q = &c->an[i];
         /* rows from the anchors: a wide-solved point keeps only those */
-        vec3 ra_n = v3_cross(p->ra, n), rb_n = v3_cross(p->rb, n);
+        vec3 ra_n = v3_cross(q->ra, n), rb_n = v3_cross(q->rb, n);
         vec3 ia_n = m3_mulv(A->inv_inertia, ra_n), ib_n = m3_mulv(B->inv_inertia, rb_n);
-        double s = p->base_separation + v3_dot(n, dpab) + v3_dot(ctx->dq[c->b], rb_n) - v3_dot(ctx->dq[c->a], ra_n);
+        double s = q->base_separation + v3_dot(n, dpab) + v3_dot(ctx->dq[c->b], rb_n) - v3_dot(ctx->dq[c->a], ra_n);
         double k = fa * (locked_inv_mass(A->inv_mass, n, lock_a) + v3_dot(ra_n, ia_n)) +
                    fb * (locked_inv_mass(B->inv_mass, n, lock_b) + v3_dot(rb_n, ib_n));
         shock_normal[i] = 0.0;
@@ -270,11 +272,12 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
     if (!ctx->friction || c->friction <= 0) return;
     for (int i = 0; i < c->count; i++) {
         constraint_point *p = &c->p[i];
-        vec3 vp = v3_sub(v3_add(B->v, v3_cross(B->w, p->rb)), v3_add(A->v, v3_cross(A->w, p->ra)));
+        const constraint_anchor *q = &c->an[i];
+        vec3 vp = v3_sub(v3_add(B->v, v3_cross(B->w, q->rb)), v3_add(A->v, v3_cross(A->w, q->ra)));
         vec3 t[2] = {c->t1, c->t2};
         double nw[2];
         for (int j = 0; j < 2; j++) {
-            vec3 rat = v3_cross(p->ra, t[j]), rbt = v3_cross(p->rb, t[j]);
+            vec3 rat = v3_cross(q->ra, t[j]), rbt = v3_cross(q->rb, t[j]);
             double k = fa * (locked_inv_mass(A->inv_mass, t[j], lock_a) + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
                        fb * (locked_inv_mass(B->inv_mass, t[j], lock_b) + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
             nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
@@ -285,9 +288,9 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         coulomb_clamp(&t1, &t2, c->friction * dmax(p->normal_impulse + shock_normal[i], 0.0));
         vec3 P = v3_add(v3_scale(t[0], t1 - o1), v3_scale(t[1], t2 - o2));
         A->v = v3_madd(A->v, -fa * A->inv_mass, P);
-        A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(p->ra, P)), fa));
+        A->w = v3_sub(A->w, v3_scale(m3_mulv(A->inv_inertia, v3_cross(q->ra, P)), fa));
         B->v = v3_madd(B->v, fb * B->inv_mass, P);
-        B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(p->rb, P)), fb));
+        B->w = v3_add(B->w, v3_scale(m3_mulv(B->inv_inertia, v3_cross(q->rb, P)), fb));
         if (c->locked) { A->v = keep_in_plane(A->v, lock_a); B->v = keep_in_plane(B->v, lock_b); }
     }
 }

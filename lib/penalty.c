@@ -83,25 +83,26 @@ int penalty_check(const step_context *ctx, char *msg, size_t msg_size)
 }
 
 static void friction_rows(impulse_body *A, impulse_body *B, contact_constraint *c, constraint_point *p,
-                          const constraint_rows *r)
+                          const constraint_anchor *q, const constraint_rows *r)
 {
-    vec3 vp = v3_sub(impulse_point_velocity(B, p->rb), impulse_point_velocity(A, p->ra));
+    vec3 vp = v3_sub(impulse_point_velocity(B, q->rb), impulse_point_velocity(A, q->ra));
     double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
     double l1 = o1 - r->tangent_mass[0] * v3_dot(vp, c->t1);
     double l2 = o2 - r->tangent_mass[1] * v3_dot(vp, c->t2);
     coulomb_clamp(&l1, &l2, c->friction * p->normal_impulse);
     p->tangent_impulse[0] = l1;
     p->tangent_impulse[1] = l2;
-    impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, l1 - o1), v3_scale(c->t2, l2 - o2)));
+    impulse_apply(B, A, q->rb, q->ra, v3_add(v3_scale(c->t1, l1 - o1), v3_scale(c->t2, l2 - o2)));
 }
 
 /* a point whose spring let go keeps no friction impulse either */
-static void drop_friction(impulse_body *A, impulse_body *B, contact_constraint *c, constraint_point *p)
+static void drop_friction(impulse_body *A, impulse_body *B, contact_constraint *c, constraint_point *p,
+                          const constraint_anchor *q)
 {
     double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
     if (o1 == 0.0 && o2 == 0.0) return;
     p->tangent_impulse[0] = p->tangent_impulse[1] = 0.0;
-    impulse_apply(B, A, p->rb, p->ra, v3_add(v3_scale(c->t1, -o1), v3_scale(c->t2, -o2)));
+    impulse_apply(B, A, q->rb, q->ra, v3_add(v3_scale(c->t1, -o1), v3_scale(c->t2, -o2)));
 }
 
 void penalty_solve(const step_context *ctx)
@@ -127,7 +128,7 @@ void penalty_solve(const step_context *ctx)
             vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
                             v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
             p->total_normal_impulse += p->normal_impulse;
-            impulse_apply(&bodies[c->b], &bodies[c->a], p->rb, p->ra, P);
+            impulse_apply(&bodies[c->b], &bodies[c->a], c->an[i].rb, c->an[i].ra, P);
         }
     }
     int sweeps = implicit ? PENALTY_MAX_SWEEPS : 1;
@@ -140,11 +141,12 @@ void penalty_solve(const step_context *ctx)
             for (int i = 0; i < c->count; i++) {
                 constraint_point *p = &c->p[i];
                 const constraint_rows *r = &c->r[i];
+                const constraint_anchor *q = &c->an[i];
                 if (r->normal_mass <= 0.0) continue;
-                double s = p->base_separation + v3_dot(c->n, dpab) + v3_dot(dq[c->b], r->rb_n) - v3_dot(dq[c->a], r->ra_n);
+                double s = q->base_separation + v3_dot(c->n, dpab) + v3_dot(dq[c->b], r->rb_n) - v3_dot(dq[c->a], r->ra_n);
                 double total = 0.0; /* apart: no spring (a warm impulse is taken back) */
                 if (s < 0.0) {
-                    double vn = impulse_relative_normal_velocity(B, A, p->rb, p->ra, c->n);
+                    double vn = impulse_relative_normal_velocity(B, A, q->rb, q->ra, c->n);
                     double kk = c->spring[i].k, cd = c->spring[i].c;
                     if (implicit) {
                         /* P = -h (k (s + h vn') + c vn') with vn' = vn + dP / m_eff: the
@@ -161,10 +163,10 @@ void penalty_solve(const step_context *ctx)
                 if (d == 0.0 && total == 0.0 && p->tangent_impulse[0] == 0.0 && p->tangent_impulse[1] == 0.0) continue;
                 p->normal_impulse = total;
                 p->total_normal_impulse += d;
-                impulse_apply(B, A, p->rb, p->ra, v3_scale(c->n, d));
+                impulse_apply(B, A, q->rb, q->ra, v3_scale(c->n, d));
                 /* Coulomb friction on this sub-step's spring impulse */
-                if (friction_on && c->friction > 0.0) friction_rows(A, B, c, p, r);
-                else if (total == 0.0) drop_friction(A, B, c, p);
+                if (friction_on && c->friction > 0.0) friction_rows(A, B, c, p, q, r);
+                else if (total == 0.0) drop_friction(A, B, c, p, q);
                 if (total > largest) largest = total;
                 if (fabs(d) > change) change = fabs(d);
             }

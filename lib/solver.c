@@ -275,6 +275,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     /* plane normals (attach_extras): a moving body's, when it is locked to a plane */
     c->locked = (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
                 (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
+    c->an = NULL;
     c->r = NULL;
     c->spring = NULL;
     c->x = NULL;
@@ -559,21 +560,35 @@ static contact_constraint *scalar_constraint(const step_context *ctx, const solv
     return &ctx->constraints[work->scalar ? work->scalar[k] : k];
 }
 
-/* The rows of the manifolds the scalar passes take (and the penalty
- * model's springs), packed in their order; a wide-solved manifold has its
- * rows in its lanes only. */
+/* The anchors and rows of the manifolds the scalar passes take (and the
+ * penalty model's springs), packed in their order; a wide-solved manifold
+ * has them in its lanes only, and its anchors also here when the shock pass
+ * (which reads every manifold's) runs. */
 static int attach_rows(carom_world *w, const step_context *ctx, solver_work *work)
 {
     solver_memory *sm = &w->scratch.solver;
-    int n = 0;
+    int n = 0, anchors;
     for (int k = 0; k < work->scalar_count; k++) n += scalar_constraint(ctx, work, k)->count;
-    if (n == 0) return 1;
-    if (!array_reserve(&sm->rows, &sm->rows_capacity, n, sizeof(constraint_rows))) return 0;
+    anchors = work->shock_count > 0 ? ctx->point_count : n;
+    if (anchors == 0) return 1;
+    if (!array_reserve(&sm->anchors, &sm->anchors_capacity, anchors, sizeof(constraint_anchor))) return 0;
+    if (n > 0 && !array_reserve(&sm->rows, &sm->rows_capacity, n, sizeof(constraint_rows))) return 0;
     if (ctx->penalty && !array_reserve(&sm->springs, &sm->springs_capacity, n, sizeof(penalty_spring))) return 0;
+    constraint_anchor *q = sm->anchors;
     constraint_rows *r = sm->rows;
     penalty_spring *sp = sm->springs;
+    if (work->shock_count > 0) {
+        for (int k = 0; k < ctx->constraint_count; k++) {
+            ctx->constraints[k].an = q;
+            q += ctx->constraints[k].count;
+        }
+    }
     for (int k = 0; k < work->scalar_count; k++) {
         contact_constraint *c = scalar_constraint(ctx, work, k);
+        if (!c->an) {
+            c->an = q;
+            q += c->count;
+        }
         c->r = r;
         r += c->count;
         if (ctx->penalty) {
@@ -910,6 +925,7 @@ static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *
 void solver_memory_free(solver_memory *m)
 {
     free(m->block);
+    free(m->anchors);
     free(m->rows);
     free(m->springs);
     free(m->extra);

@@ -9,6 +9,8 @@
 typedef struct solver_memory {
     void *block;                 /* constraints, their points, shock and contact lists */
     int block_capacity;
+    void *anchors;               /* the scalar and shock passes' anchors (constraint_anchor) */
+    int anchors_capacity;
     void *rows;                  /* the scalar passes' rows (constraint_rows) */
     int rows_capacity;
     void *springs;               /* the penalty model's springs (penalty_spring) */

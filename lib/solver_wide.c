@@ -560,13 +560,17 @@ LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, i
                                double deepest)
 {
     for (int l = 0; l < wb->lanes; l++) {
-        constraint_point *cold = &lm->c[l]->p[i];
+        const contact_constraint *c = lm->c[l];
+        constraint_point *cold = &c->p[i];
         double s = (*sep)[l];
-        cold->relative_velocity = contact_approach_velocity((*vn)[l], lm->c[l]->gravity_closing, s);
-        cold->base_separation = s;
+        cold->relative_velocity = contact_approach_velocity((*vn)[l], c->gravity_closing, s);
         cold->total_normal_impulse = 0.0;
-        cold->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
-        cold->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
+        if (c->an) { /* the shock pass runs */
+            constraint_anchor *q = &c->an[i];
+            q->base_separation = s;
+            q->ra = v3(ra[0][l], ra[1][l], ra[2][l]);
+            q->rb = v3(rb[0][l], rb[1][l], rb[2][l]);
+        }
         if (-s > deepest) deepest = -s;
     }
     return deepest;
