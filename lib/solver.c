@@ -59,6 +59,26 @@ typedef struct solver_work {
     int points;
 } solver_work;
 
+/* What the sub-steps read of a solver body, computed once per step from the
+ * store (nothing in the step changes the forces, damping, flags or local
+ * inertia it is made of): the same expressions the sub-steps evaluated
+ * before, so the same bits. */
+enum {
+    STEP_TORQUE = 1,       /* BODY_HAS_FORCE: w += h I^-1 torque */
+    STEP_LINEAR_DAMP = 2,  /* linear_damping > 0 */
+    STEP_ANGULAR_DAMP = 4, /* angular_damping > 0 */
+    STEP_FLIGHT = 8,       /* dynamic and undamped: free flight integrates the constant acceleration */
+    STEP_FREE_SPIN = 16,   /* dynamic, unlocked, anisotropic: the midpoint rotation (rotation.c) */
+    STEP_KINEMATIC = 32    /* inv_mass 0: turned by the exact exponential map */
+};
+typedef struct body_step {
+    int flags;             /* the fields below are set only where a flag says they are read */
+    vec3 acc;              /* gravity (scaled) and force over mass; not STEP_KINEMATIC */
+    vec3 spin;             /* I^-1 torque at the step's inertia; STEP_TORQUE */
+    double linear_keep;    /* 1 / (1 + h linear_damping); STEP_LINEAR_DAMP */
+    double angular_keep;   /* 1 / (1 + h angular_damping); STEP_ANGULAR_DAMP */
+} body_step;
+
 /* Keeps plane-locked bodies in their plane: in-plane velocity, spin about the normal. */
 static void project_planar(const body_store *bs, const step_context *ctx)
 {
@@ -129,6 +149,36 @@ static int compute_levels(contact_constraint *cc, int n, const impulse_body *bod
 
 /* ---- the stages ---------------------------------------------------------- */
 
+static void body_step_of(const body_store *bs, int i, const impulse_body *B, const step_context *ctx, body_step *m)
+{
+    if (B->inv_mass == 0.0) {
+        m->flags = STEP_KINEMATIC;
+        return;
+    }
+    double h = ctx->h;
+    int flags = 0;
+    m->acc = v3_madd(v3_scale(ctx->gravity, bs->gravity_scale[i]), B->inv_mass, bs->force[i]);
+    uint32_t bf = bs->flags[i];
+    if (bf & BODY_HAS_FORCE) {
+        flags |= STEP_TORQUE;
+        m->spin = m3_mulv(B->inv_inertia, bs->torque[i]);
+    }
+    double ld = bs->linear_damping[i], ad = bs->angular_damping[i];
+    if (ld > 0) {
+        flags |= STEP_LINEAR_DAMP;
+        m->linear_keep = 1.0 / (1.0 + h * ld);
+    } else {
+        flags |= STEP_FLIGHT;
+    }
+    if (ad > 0) {
+        flags |= STEP_ANGULAR_DAMP;
+        m->angular_keep = 1.0 / (1.0 + h * ad);
+    }
+    if (!(bf & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION)) && !rotation_is_isotropic(&bs->inv_inertia_local[i]))
+        flags |= STEP_FREE_SPIN;
+    m->flags = flags;
+}
+
 /* Awake bodies, contiguous: index 0 is the shared immovable body. */
 static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
 {
@@ -151,6 +201,9 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     void *p4 = realloc(s->inertia_start, sizeof *s->inertia_start * (size_t)cap);
     if (!p4) return 0;
     s->inertia_start = p4;
+    if (!array_reserve(&s->solver.motion, &s->solver.motion_capacity, cap, sizeof(body_step))) return 0;
+    body_step *motion = s->solver.motion;
+    motion[0].flags = STEP_KINEMATIC;
     impulse_body *bodies = s->bodies;
     memset(&bodies[0], 0, sizeof bodies[0]);
     s->delta_position[0] = v3_zero();
@@ -172,6 +225,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         s->inertia_start[k] = m3_inverse(bodies[k].inv_inertia);
         s->delta_position[k] = v3_zero();
         s->delta_rotation[k] = v3_zero();
+        body_step_of(bs, i, &bodies[k], ctx, &motion[k]);
     }
     ctx->bodies = bodies;
     ctx->dp = s->delta_position;
@@ -629,20 +683,19 @@ typedef struct body_job {
 static void integrate_velocities_range(int begin, int end, int worker, void *p)
 {
     const body_job *j = p;
-    const body_store *bs = &j->w->bodies;
     const step_context *ctx = j->ctx;
+    const body_step *motion = j->w->scratch.solver.motion;
     double h = ctx->h;
     (void)worker;
     for (int b = 1 + begin; b < 1 + end; b++) {
-        int slot = ctx->body_slot[b];
+        const body_step *m = &motion[b];
+        if (m->flags & STEP_KINEMATIC) continue;
         impulse_body *B = &ctx->bodies[b];
-        if (B->inv_mass == 0.0) continue; /* kinematic */
-        vec3 acc = v3_madd(v3_scale(ctx->gravity, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
-        B->v = v3_madd(B->v, h, acc);
+        B->v = v3_madd(B->v, h, m->acc);
         /* a torque adds tau h to the angular momentum: w = I_start^-1 L as the solver keeps it */
-        if (bs->flags[slot] & BODY_HAS_FORCE) B->w = v3_madd(B->w, h, m3_mulv(B->inv_inertia, bs->torque[slot]));
-        if (bs->linear_damping[slot] > 0) B->v = v3_scale(B->v, 1.0 / (1.0 + h * bs->linear_damping[slot]));
-        if (bs->angular_damping[slot] > 0) B->w = v3_scale(B->w, 1.0 / (1.0 + h * bs->angular_damping[slot]));
+        if (m->flags & STEP_TORQUE) B->w = v3_madd(B->w, h, m->spin);
+        if (m->flags & STEP_LINEAR_DAMP) B->v = v3_scale(B->v, m->linear_keep);
+        if (m->flags & STEP_ANGULAR_DAMP) B->w = v3_scale(B->w, m->angular_keep);
     }
 }
 
@@ -691,20 +744,19 @@ static void solve(carom_world *w, const step_context *ctx, const solver_work *wo
 /* Rotation over one sub-step: between impulses L = I w is what holds, so a
  * free body rotates with the midpoint w of Euler's equations (rotation.c);
  * the solver keeps w = I_start^-1 L for the step's impulses (a sphere's or
- * a cube's w is constant between impulses: the plain update). Returns the
- * angular velocity the rotation used. */
-static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, const mat3 *inertia_start, double h)
+ * a cube's w is constant between impulses: the plain update, which
+ * integrate_positions_range does itself). Returns the angular velocity the
+ * rotation used. */
+static vec3 integrate_rotation(body_store *bs, int slot, const impulse_body *B, int flags, const mat3 *inertia_start,
+                               double h)
 {
     vec3 wr = B->w;
-    if (B->inv_mass > 0.0 && !(bs->flags[slot] & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION)) &&
-        !rotation_is_isotropic(&bs->inv_inertia_local[slot])) {
+    if (flags & STEP_FREE_SPIN) {
         vec3 L = m3_mulv(*inertia_start, B->w);
         bs->rotation[slot] = rotation_free_step(bs->rotation[slot], &bs->inv_inertia_local[slot], L, h, &wr);
-    } else if (B->inv_mass == 0.0) {
+    } else {
         /* a kinematic body's w is constant: turn it by the exact exponential map */
         bs->rotation[slot] = q_normalize(q_mul(q_exp(v3_scale(wr, h)), bs->rotation[slot]));
-    } else {
-        bs->rotation[slot] = q_integrate(bs->rotation[slot], wr, h);
     }
     return wr;
 }
@@ -714,22 +766,28 @@ static void integrate_positions_range(int begin, int end, int worker, void *p)
     const body_job *j = p;
     body_store *bs = &j->w->bodies;
     const step_context *ctx = j->ctx;
+    const body_step *motion = j->w->scratch.solver.motion;
+    const int *in_contact = j->work->in_contact;
     double h = ctx->h;
     (void)worker;
     for (int b = 1 + begin; b < 1 + end; b++) {
         int slot = ctx->body_slot[b];
         const impulse_body *B = &ctx->bodies[b];
+        const body_step *m = &motion[b];
         vec3 dx = v3_scale(B->v, h);
-        if (!j->work->in_contact[b] && B->inv_mass > 0.0 && !(bs->linear_damping[slot] > 0)) {
+        if ((m->flags & STEP_FLIGHT) && !in_contact[b]) {
             /* in free flight the acceleration is constant over the sub-step: x += v0 h + a h^2 / 2
              * exactly (v = v0 + a h here), where semi-implicit Euler's v h flies an arc low by v h / 2 */
-            vec3 acc = v3_madd(v3_scale(ctx->gravity, bs->gravity_scale[slot]), B->inv_mass, bs->force[slot]);
-            dx = v3_madd(dx, -0.5 * h * h, acc);
+            dx = v3_madd(dx, -0.5 * h * h, m->acc);
         }
         bs->center[slot] = v3_add(bs->center[slot], dx);
         ctx->dp[b] = v3_add(ctx->dp[b], dx);
         if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
-            vec3 wr = integrate_rotation(bs, slot, B, &j->w->scratch.inertia_start[b], h);
+            vec3 wr = B->w;
+            if (m->flags & (STEP_FREE_SPIN | STEP_KINEMATIC))
+                wr = integrate_rotation(bs, slot, B, m->flags, &j->w->scratch.inertia_start[b], h);
+            else
+                bs->rotation[slot] = q_integrate(bs->rotation[slot], wr, h);
             ctx->dq[b] = v3_madd(ctx->dq[b], h, wr);
         }
     }
@@ -933,6 +991,7 @@ void solver_memory_free(solver_memory *m)
     free(m->order);
     free(m->last_order);
     free(m->mark);
+    free(m->motion);
     memset(m, 0, sizeof *m);
 }
 

@@ -25,6 +25,8 @@ typedef struct solver_memory {
      * zeroed per-contact mark; only the work of the sort depends on them */
     int *last_order, *mark;
     int last_count, last_capacity, mark_capacity;
+    void *motion;                /* per solver body: what its sub-steps read of it (body_step, solver.c) */
+    int motion_capacity;
 } solver_memory;
 void solver_memory_free(solver_memory *m);
 
