@@ -278,27 +278,51 @@ static int touching_impact(const contact_constraint *c, const impulse_body *A, c
  * bodies, and the stiffer spring rocked the 10-column 7 cm sideways (2.55 cm
  * unstiffened). docs/physics.md section 5 has the measurements. */
 #define LOAD_STIFFENING_MAX 1.4142135623730951
-static softness loaded_softness(const step_context *ctx, const impulse_body *A, const impulse_body *B,
-                                const contact_point_state *warm, int count)
+
+/* What loaded_softness reads that is the same for every manifold of the
+ * step: whether it stiffens at all, and the softness at the cap (most
+ * loaded contacts reach it), one for a pair with a fixed body, one without. */
+typedef struct load_softness {
+    int loaded;
+    double load_scale;           /* h |g| */
+    softness capped[2];          /* [fixed] */
+} load_softness;
+
+static double loaded_stiffness(const step_context *ctx, int fixed, double f)
+{
+    double hertz = (fixed ? 2.0 : 1.0) * ctx->contact_hertz;
+    /* never past a quarter of the sub-step rate, the setting's own cap */
+    return dmin(hertz * f, dmax(hertz, 0.25 * ctx->inv_h));
+}
+
+static void load_softness_init(load_softness *ls, const step_context *ctx)
+{
+    ls->loaded = ctx->relax_iterations > 0 && ctx->gravity_length > 0.0 && ctx->warm_starting;
+    ls->load_scale = ctx->h * ctx->gravity_length;
+    for (int fixed = 0; fixed < 2; fixed++)
+        ls->capped[fixed] = make_softness(loaded_stiffness(ctx, fixed, LOAD_STIFFENING_MAX), ctx->contact_damping_ratio,
+                                          ctx->h);
+}
+
+static softness loaded_softness(const step_context *ctx, const load_softness *ls, const impulse_body *A,
+                                const impulse_body *B, const contact_point_state *warm, int count)
 {
     int fixed = A->inv_mass == 0.0 || B->inv_mass == 0.0;
-    softness base = fixed ? ctx->static_soft : ctx->soft;
     double inv_m = A->inv_mass + B->inv_mass;
-    if (!(ctx->relax_iterations > 0 && ctx->gravity_length > 0.0 && inv_m > 0.0 && ctx->warm_starting)) return base;
+    if (!(ls->loaded && inv_m > 0.0)) return fixed ? ctx->static_soft : ctx->soft;
     double load = 0.0;
     for (int j = 0; j < count; j++) load += warm[j].normal_impulse;
-    if (!(load > 0.0)) return base;
-    double ratio = load * inv_m / (ctx->h * ctx->gravity_length);
-    double hertz = (fixed ? 2.0 : 1.0) * ctx->contact_hertz;
+    if (!(load > 0.0)) return fixed ? ctx->static_soft : ctx->soft;
+    double ratio = load * inv_m / ls->load_scale;
     double f = dmin(sqrt(1.0 + ratio), LOAD_STIFFENING_MAX);
-    /* never past a quarter of the sub-step rate, the setting's own cap */
-    double stiff = dmin(hertz * f, dmax(hertz, 0.25 * ctx->inv_h));
-    return make_softness(stiff, ctx->contact_damping_ratio, ctx->h);
+    if (f == LOAD_STIFFENING_MAX) return ls->capped[fixed];
+    return make_softness(loaded_stiffness(ctx, fixed, f), ctx->contact_damping_ratio, ctx->h);
 }
 
 /* One header per manifold the collision stage listed as touching: bodies,
  * basis, material, softness; the points stay for prepare_points. */
-static void fill_constraint(carom_world *w, const step_context *ctx, contact_constraint *c, int i)
+static void fill_constraint(carom_world *w, const step_context *ctx, const load_softness *ls, contact_constraint *c,
+                            int i)
 {
     const body_store *bs = &w->bodies;
     contact *ct = &w->contacts.items[i];
@@ -320,7 +344,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
     c->friction = cd->friction;
     c->restitution = ctx->restitution ? cd->restitution : 0.0;
     c->rolling = ctx->friction ? cd->rolling_resistance : 0.0;
-    c->soft = loaded_softness(ctx, &bodies[c->a], &bodies[c->b], cd->state, cd->m.count);
+    c->soft = loaded_softness(ctx, ls, &bodies[c->a], &bodies[c->b], cd->state, cd->m.count);
     c->wide_batch = -1;
     c->m = &cd->m;
     c->warm = cd->state;
@@ -342,11 +366,10 @@ static void fill_constraint(carom_world *w, const step_context *ctx, contact_con
         c->soft.impulse_scale = 0.0;
     }
     /* every force acting over the step, not only gravity: b's acceleration relative to a along n */
-    vec3 grav = ctx->gravity;
-    vec3 acc_a = bodies[c->a].inv_mass > 0.0
-                     ? v3_madd(v3_scale(grav, bs->gravity_scale[sa]), bodies[c->a].inv_mass, bs->force[sa]) : v3_zero();
-    vec3 acc_b = bodies[c->b].inv_mass > 0.0
-                     ? v3_madd(v3_scale(grav, bs->gravity_scale[sb]), bodies[c->b].inv_mass, bs->force[sb]) : v3_zero();
+    /* (body_step.acc, computed by gather_bodies; zero for an unmoved body) */
+    const body_step *motion = w->scratch.solver.motion;
+    vec3 acc_a = motion[c->a].flags & STEP_KINEMATIC ? v3_zero() : motion[c->a].acc;
+    vec3 acc_b = motion[c->b].flags & STEP_KINEMATIC ? v3_zero() : motion[c->b].acc;
     c->gravity_closing = v3_dot(c->n, v3_sub(acc_b, acc_a));
 }
 
@@ -366,8 +389,10 @@ static void fill_constraints_range(int begin, int end, int worker, void *p)
 {
     const constraint_job *j = p;
     const int *touching = j->w->scratch.touching;
+    load_softness ls;
+    load_softness_init(&ls, j->ctx);
     (void)worker;
-    for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &j->cc[k], touching[k]);
+    for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
 }
 
 /* The order the manifolds are solved in, from the geometry alone, so a scene
