@@ -120,33 +120,12 @@ int contact_add(contact_set *cs, int a, int b) { return contact_add_sub(cs, a, b
 
 int contact_set_reserve(contact_set *cs, int n)
 {
-    if (cs->map.count == 0 && (n + 1) * 2 > cs->map.capacity) { /* empty: the same capacity at once */
-        int capacity = cs->map.capacity;
-        while ((n + 1) * 2 > capacity) capacity *= 2;
-        pair_map m;
-        if (!map_init(&m, capacity)) {
-            free(m.keys);
-            free(m.subs);
-            free(m.values);
-            return 0;
-        }
-        free(cs->map.keys);
-        free(cs->map.subs);
-        free(cs->map.values);
-        cs->map = m;
-    }
-    while ((n + 1) * 2 > cs->map.capacity)
-        if (!map_grow(&cs->map)) return 0;
     return array_reserve((void **)&cs->items, &cs->capacity, n, sizeof *cs->items) &&
            array_reserve((void **)&cs->data, &cs->data_capacity, n, sizeof *cs->data);
 }
 
-int contact_add_new_sub(contact_set *cs, int a, int b, uint32_t sub)
+int contact_append(contact_set *cs, int a, int b, uint32_t sub)
 {
-    if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
-    uint64_t key = pair_key(a, b);
-    int slot = map_slot(&cs->map, key, sub);
-    if (cs->map.keys[slot] == key) return -2;
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
     if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->count + 1, sizeof *cs->data)) return -1;
     int i = cs->count++;
@@ -157,11 +136,59 @@ int contact_add_new_sub(contact_set *cs, int a, int b, uint32_t sub)
     c->id_b = a < b ? b : a;
     c->cache.feature = -1;
     c->sub = sub;
-    cs->map.keys[slot] = key; /* where map_put would put it: one probe */
-    cs->map.subs[slot] = sub;
-    cs->map.values[slot] = i;
-    cs->map.count++;
     return i;
+}
+
+int contact_set_index(contact_set *cs, int *repeated)
+{
+    int n = cs->count;
+    *repeated = -1;
+    int capacity = 64;
+    while ((n + 1) * 2 > capacity) capacity *= 2;
+    uint32_t mask = (uint32_t)capacity - 1;
+    pair_map m;
+    int ok = map_init(&m, capacity);
+    int *start = calloc((size_t)capacity + 1, sizeof *start);
+    int *order = malloc(sizeof *order * (size_t)(n > 0 ? n : 1));
+    uint32_t *home = malloc(sizeof *home * (size_t)(n > 0 ? n : 1));
+    if (!ok || !start || !order || !home) {
+        free(m.keys);
+        free(m.subs);
+        free(m.values);
+        free(start);
+        free(order);
+        free(home);
+        return 0;
+    }
+    /* the contacts by home slot (counting sort, stable) */
+    for (int i = 0; i < n; i++) {
+        home[i] = hash_key(pair_key(cs->items[i].id_a, cs->items[i].id_b), cs->items[i].sub) & mask;
+        start[home[i] + 1]++;
+    }
+    for (int k = 0; k < capacity; k++) start[k + 1] += start[k];
+    for (int i = 0; i < n; i++) order[start[home[i]]++] = i;
+    for (int k = 0; k < n; k++) {
+        int i = order[k];
+        uint64_t key = pair_key(cs->items[i].id_a, cs->items[i].id_b);
+        int slot = map_slot(&m, key, cs->items[i].sub);
+        if (m.keys[slot] == key) { /* the later of the two repeats the earlier */
+            int later = i > m.values[slot] ? i : m.values[slot];
+            if (*repeated < 0 || later < *repeated) *repeated = later;
+            continue;
+        }
+        m.keys[slot] = key;
+        m.subs[slot] = cs->items[i].sub;
+        m.values[slot] = i;
+        m.count++;
+    }
+    free(start);
+    free(order);
+    free(home);
+    free(cs->map.keys);
+    free(cs->map.subs);
+    free(cs->map.values);
+    cs->map = m;
+    return 1;
 }
 
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)

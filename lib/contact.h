@@ -74,14 +74,20 @@ void contact_set_free(contact_set *cs);
 int contact_find(const contact_set *cs, int a, int b);
 /* Adds a contact for a new pair; returns its index or -1 on out of memory. */
 int contact_add(contact_set *cs, int a, int b);
-/* Room for n contacts without growing (restoring a snapshot). 0 on out of memory. */
+/* Room for n contacts without growing the arrays (restoring a snapshot: the
+ * map is built by contact_set_index). 0 on out of memory. */
 int contact_set_reserve(contact_set *cs, int n);
 /* The same for a pair's extra manifold number sub (> 0). */
 int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub);
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub);
-/* contact_add_sub for a pair and sub not yet in the set (one map probe):
- * -2 when it is there already, -1 on out of memory. */
-int contact_add_new_sub(contact_set *cs, int a, int b, uint32_t sub);
+/* Restoring a snapshot: contacts appended without the pair map (index
+ * -1 on out of memory), then the map built for all of them at once, in the
+ * order of their home slots (a sequential walk of the table; the map's
+ * layout is never observable). contact_set_index returns 0 on out of
+ * memory; *repeated: -1, or the first contact whose pair and sub an
+ * earlier one has (it is not in the map). */
+int contact_append(contact_set *cs, int a, int b, uint32_t sub);
+int contact_set_index(contact_set *cs, int *repeated);
 /* Swap-removes contact i. */
 void contact_remove(contact_set *cs, int i);
 /* Carries warm-start impulses from the old manifold to the new one. */

@@ -1170,7 +1170,9 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
     const contact_set *cs = &w->contacts;
     mix_memo *memo = malloc(sizeof *memo); /* (without it, every contact mixes its own) */
     if (memo) mix_memo_init(memo, t->of_body);
+    size_t count_at = o->pos;
     put_varint(o, (uint64_t)cs->count);
+    acct(o, SNAP_FIELD_contact_header, count_at);
     int last_a = 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
@@ -1374,6 +1376,7 @@ typedef struct body_class {
     double force_threshold, rolling_resistance;
     size_t shape_at;        /* where its shape starts in the snapshot */
     size_t start, end;      /* its bytes */
+    shape shape;            /* read once; bodies of a primitive or hull class copy it */
 } body_class;
 
 /* One class, checked as the API checks a body def; its shape is read (and
@@ -1437,7 +1440,8 @@ static int read_class(reader *r, body_class *k)
     k->shape_at = r->pos;
     shape sh;
     int ok = read_shape(r, &sh, type, 0);
-    shape_free_data(&sh);
+    if (ok) k->shape = sh;
+    else shape_free_data(&sh);
     k->end = r->pos;
     return ok;
 }
@@ -1528,6 +1532,36 @@ static void body_label(char what[48], int i)
     what[5 + n] = '\0';
 }
 
+static void free_classes(body_class *classes, int n)
+{
+    for (int k = 0; k < n; k++) shape_free_data(&classes[k].shape);
+    free(classes);
+}
+
+/* A body's own copy of its class's shape: copied (a hull cloned) where the
+ * copy is the shape the class read; meshes, height fields and compounds are
+ * read again from the class's bytes. 0 on failure (reported). */
+static int class_shape(reader *r, const body_class *k, shape *out)
+{
+    const shape *ks = &k->shape;
+    switch (ks->type) {
+    case SHAPE_SPHERE: case SHAPE_BOX: case SHAPE_CAPSULE: case SHAPE_CYLINDER: case SHAPE_PLANE:
+        *out = *ks;
+        return 1;
+    case SHAPE_HULL:
+        *out = *ks;
+        out->hull = hull_clone(ks->hull);
+        return out->hull ? 1 : bad(r, "out of memory");
+    default: {
+        reader sr = *r;
+        sr.pos = k->shape_at;
+        if (read_shape(&sr, out, k->type, 0)) return 1;
+        r->failed = 1;
+        return 0;
+    }
+    }
+}
+
 /* class_of: each body's class (the caller frees it, whatever the result) */
 static int read_bodies(reader *r, carom_world *w, int **class_of)
 {
@@ -1536,14 +1570,14 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
     int class_count = get_small(r, 0, 1 << 26, 0, "class count");
     if (r->failed) return 0;
     if ((size_t)class_count * 200 > r->size - r->pos) return bad(r, "truncated: %d body classes", class_count);
-    body_class *classes = malloc(sizeof *classes * (size_t)(class_count > 0 ? class_count : 1));
+    body_class *classes = calloc((size_t)(class_count > 0 ? class_count : 1), sizeof *classes);
     if (!classes) return bad(r, "out of memory");
     for (int k = 0; k < class_count; k++)
-        if (!read_class(r, &classes[k])) { free(classes); return 0; }
-    if (!distinct_classes(r, classes, class_count)) { free(classes); return 0; }
+        if (!read_class(r, &classes[k])) { free_classes(classes, class_count); return 0; }
+    if (!distinct_classes(r, classes, class_count)) { free_classes(classes, class_count); return 0; }
     int count = get_small(r, 0, s->id_count, 0, "body count");
     if (r->failed || (size_t)count * 6 > r->size - r->pos) { /* the shortest body record */
-        free(classes);
+        free_classes(classes, class_count);
         return r->failed ? 0 : bad(r, "truncated: %d bodies need more than the bytes left", count);
     }
     /* the dense arrays, sized for the bodies (the id table is kept aside meanwhile) */
@@ -1557,10 +1591,10 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
     s->id_capacity = id_capacity;
     s->id_count = id_count;
     s->free_id = free_id;
-    if (!ok) { free(classes); return bad(r, "out of memory"); }
-    if (!check_ids(r, s, count)) { free(classes); return 0; }
+    if (!ok) { free_classes(classes, class_count); return bad(r, "out of memory"); }
+    if (!check_ids(r, s, count)) { free_classes(classes, class_count); return 0; }
     *class_of = malloc(sizeof **class_of * (size_t)(count > 0 ? count : 1));
-    if (!*class_of) { free(classes); return bad(r, "out of memory"); }
+    if (!*class_of) { free_classes(classes, class_count); return bad(r, "out of memory"); }
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
@@ -1621,11 +1655,9 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
             bad(r, "body %d force, sleep timer or plane offset out of range", i);
             break;
         }
-        /* the shape, again from its class (each body owns its copy) */
-        reader sr = *r;
-        sr.pos = k->shape_at;
+        /* the shape, from its class (each body owns its copy) */
         s->count = i; /* the shapes of bodies 0..i-1 are owned: freed if a later one fails */
-        if (!read_shape(&sr, &s->shapes[i], k->type, 0)) { r->failed = 1; break; }
+        if (!class_shape(r, k, &s->shapes[i])) break;
         s->count = i + 1;
         xform x = body_xform(s, i);
         s->previous_origin[i] = (bits & REC_PREVIOUS) ? get_coded_v3(r, x.p, what) : x.p;
@@ -1668,7 +1700,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         s->inv_inertia_local[i] = dynamic ? m3_inverse(s->inertia_local[i]) : m3_zero();
         body_update_inertia(s, i);
     }
-    free(classes);
+    free_classes(classes, class_count);
     if (!r->failed && classes_used != class_count) bad(r, "%d of %d body classes unused", class_count - classes_used, class_count);
     return !r->failed;
 }
@@ -1710,7 +1742,14 @@ static int read_contacts(reader *r, carom_world *w, const int *class_of)
     if (memo) mix_memo_init(memo, class_of);
     int ok = read_contact_list(r, w, count, memo);
     free(memo);
-    return ok;
+    if (!ok) return 0;
+    int repeated;
+    if (!contact_set_index(cs, &repeated)) return bad(r, "out of memory");
+    if (repeated >= 0) {
+        const contact *c = &cs->items[repeated];
+        return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", repeated, c->id_a, c->id_b, (unsigned)c->sub);
+    }
+    return 1;
 }
 
 static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *memo)
@@ -1737,8 +1776,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             ((bits & CREC_POSE) && !posed) || ((bits & CREC_REACH) && !(flags & CONTACT_APART)) ||
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
-        int ci = contact_add_new_sub(cs, a, b, sub);
-        if (ci == -2) return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", i, a, b, (unsigned)sub);
+        int ci = contact_append(cs, a, b, sub); /* (the pair map is built after the last, contact_set_index) */
         if (ci < 0) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
         contact_data *d = &cs->data[ci];

@@ -15,6 +15,8 @@
 #include <cmocka.h>
 #include "carom/carom.h"
 #include "helpers.h"
+#include "snapshot.h" /* internal: snapshot_field_bytes */
+#include "contact.h"  /* internal: the restore path's contact_set_index */
 
 
 typedef struct snap { unsigned char *data; size_t size; } snap;
@@ -463,6 +465,71 @@ static void test_contact_materials_predicted(void **state)
     printf("materials: %zu bytes without, %zu with\n", size[0], size[1]);
 }
 
+/* snapshot_field_bytes (bench/snapshot.c prints it) accounts for every byte
+ * of the snapshot, at every preset, and writes nothing itself. */
+static void test_field_bytes_add_up(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    for (int p = 0; p < 3; p++) {
+        int events = 0;
+        carom_world *w = mixed_scene(presets[p], &events);
+        snap s = take(w);
+        size_t bytes[SNAP_FIELD_COUNT], total = 0;
+        const char *names[SNAP_FIELD_COUNT];
+        assert_int_equal(snapshot_field_bytes(w, bytes, names), s.size);
+        for (int f = 0; f < SNAP_FIELD_COUNT; f++) {
+            assert_non_null(names[f]);
+            total += bytes[f];
+        }
+        if (total != s.size) fail_msg("%s: the fields hold %zu of %zu bytes", presets[p], total, s.size);
+        assert_true(bytes[SNAP_FIELD_point_local] > 0 && bytes[SNAP_FIELD_contact_header] > 0);
+        snap again = take(w);
+        assert_same_snap(s, again, 0);
+        free(s.data);
+        free(again.data);
+        carom_world_destroy(w);
+    }
+}
+
+/* The restore path's pair map, built at once in the order of the contacts'
+ * home slots: every contact found at its index, whatever the count (the
+ * map doubles through several sizes), and a repeated pair or sub named by
+ * the later of the two. */
+static void test_restored_pair_map(void **state)
+{
+    (void)state;
+    const int counts[] = {0, 1, 31, 32, 33, 1000, 5000};
+    for (int t = 0; t < 7; t++) {
+        int n = counts[t];
+        contact_set cs;
+        assert_true(contact_set_init(&cs));
+        assert_true(contact_set_reserve(&cs, n));
+        for (int i = 0; i < n; i++) {
+            int a = (i * 7919) % 3001, b = 3001 + i / 3; /* distinct pairs, in no order */
+            assert_int_equal(contact_append(&cs, b, a, (uint32_t)(i % 3)), i);
+        }
+        int repeated = 0;
+        assert_true(contact_set_index(&cs, &repeated));
+        assert_int_equal(repeated, -1);
+        for (int i = 0; i < n; i++) {
+            int a = (i * 7919) % 3001, b = 3001 + i / 3;
+            assert_int_equal(contact_find_sub(&cs, a, b, (uint32_t)(i % 3)), i);
+            assert_int_equal(cs.items[i].id_a, a);
+            assert_int_equal(cs.items[i].id_b, b);
+        }
+        assert_int_equal(contact_find_sub(&cs, 0, 3001, 7), -1);
+        if (n >= 31) { /* a copy of contact 5 appended, then one of contact 2 with another sub (not a repeat) */
+            assert_int_equal(contact_append(&cs, cs.items[5].id_a, cs.items[5].id_b, cs.items[5].sub), n);
+            assert_int_equal(contact_append(&cs, cs.items[2].id_a, cs.items[2].id_b, cs.items[2].sub + 10), n + 1);
+            assert_true(contact_set_index(&cs, &repeated));
+            assert_int_equal(repeated, n);
+            assert_int_equal(contact_find_sub(&cs, cs.items[2].id_a, cs.items[2].id_b, cs.items[2].sub + 10), n + 1);
+        }
+        contact_set_free(&cs);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -471,6 +538,8 @@ int main(void)
         cmocka_unit_test(test_bad_snapshots_refused),
         cmocka_unit_test(test_bodies_past_the_position_range),
         cmocka_unit_test(test_contact_materials_predicted),
+        cmocka_unit_test(test_field_bytes_add_up),
+        cmocka_unit_test(test_restored_pair_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
