@@ -933,9 +933,9 @@ static void test_non_finite_poses_give_no_contact(void **state)
  * of convex shapes (random sizes and orientations) is brought together
  * along a random line until GJK (an independent algorithm, lib/gjk.c) finds
  * them touching, then pushed 1 mm .. 128 mm further; at each depth the
- * manifold must hold a point with separation <= 0. Cylinders are 16-sided
- * prisms in the narrowphase, inscribed in the true cylinder GJK sees, so
- * their pairs may start overlapping up to r (1 - cos(pi / 16)) later. */
+ * manifold must hold a point with separation <= 0. Cylinders included: their
+ * pairs work on the true round shape (they were 16-sided prisms, which let
+ * them start overlapping up to r (1 - cos(pi / 16)) later: 8 mm here). */
 
 static uint64_t rng = 88172645463325252ull;
 static double urand(void) { return rnd(&rng); } /* helpers.h's xorshift64, the same sequence */
@@ -994,7 +994,6 @@ static void test_every_overlap_has_a_point(void **state)
     carom_world_def wd = carom_world_def_default();
     carom_world *w = carom_world_create(&wd);
     int checked = 0, missed = 0;
-    double worst_cyl = 0;
     for (int ta = 0; ta < N_TYPES; ta++)
         for (int tb = 0; tb < N_TYPES; tb++)
             for (int rep = 0; rep < 40; rep++) {
@@ -1020,16 +1019,11 @@ static void test_every_overlap_has_a_point(void **state)
                     if (gjk_distance(&pa, &pb).overlap) lo = mid;
                     else hi = mid;
                 }
-                int cyl = ta == 3 || tb == 3;
                 for (double depth = 1e-3; depth <= 0.13; depth *= 2) {
                     xform x = xa;
                     x.p = v3_scale(dir, hi - depth);
                     checked++;
                     if (deepest_point(sa, x, sb, xb) <= 0) continue;
-                    if (cyl) {
-                        worst_cyl = fmax(worst_cyl, depth);
-                        if (depth <= 0.48 * (1 - cos(3.14159265358979323846 / 16)) * 1.5) continue; /* the prism, a grazing line */
-                    }
                     missed++;
                     print_error("%s against %s rep %d: %.3f m into each other, the narrowphase has no point\n",
                                 type_names[ta], type_names[tb], rep, depth);
@@ -1037,10 +1031,234 @@ static void test_every_overlap_has_a_point(void **state)
                 carom_body_destroy(w, A);
                 carom_body_destroy(w, B);
             }
-    print_message("overlaps: %d poses 1 mm .. 128 mm deep, %d without a contact point; cylinder pairs start "
-                  "overlapping at most %.3f m later (the 16-sided prism)\n", checked, missed, worst_cyl);
+    print_message("overlaps: %d poses 1 mm .. 128 mm deep, %d without a contact point\n", checked, missed);
     assert_int_equal(missed, 0);
     carom_world_destroy(w);
+}
+
+/* ---- cylinder pairs against a brute force on the exact surfaces ---------------- */
+
+/* Exact signed distance of world point p to s at x (sphere, box, capsule,
+ * cylinder, or a hull made of a centred box's corners). */
+static double exact_sdf(const shape *s, xform x, vec3 p)
+{
+    vec3 l = xf_inv_point(x, p);
+    switch (s->type) {
+    case SHAPE_SPHERE: return v3_len(l) - s->radius;
+    case SHAPE_CAPSULE: {
+        double z = fmax(-s->half_height, fmin(s->half_height, l.z));
+        return v3_len(v3(l.x, l.y, l.z - z)) - s->radius;
+    }
+    case SHAPE_CYLINDER: {
+        double dr = hypot(l.x, l.y) - s->radius, dz = fabs(l.z) - s->half_height;
+        double o = hypot(fmax(dr, 0), fmax(dz, 0));
+        return o > 0 ? o : fmax(dr, dz);
+    }
+    default: {
+        vec3 h = s->half_extents;
+        if (s->type == SHAPE_HULL) {
+            h = v3_zero();
+            for (int i = 0; i < s->hull->vertex_count; i++) h = v3_max(h, v3_abs(s->hull->vertices[i]));
+        }
+        vec3 q = v3_sub(v3_abs(l), h);
+        return v3_len(v3_max(q, v3_zero())) + fmin(fmax(q.x, fmax(q.y, q.z)), 0);
+    }
+    }
+}
+
+static int surface_pieces(const shape *s) { return s->type == SHAPE_SPHERE ? 1 : s->type == SHAPE_BOX || s->type == SHAPE_HULL ? 6 : 3; }
+
+/* Piece k of s's exact surface at (u, v) in [0, 1]^2, in s's frame. */
+static vec3 surface_point(const shape *s, int k, double u, double v)
+{
+    double th = 2 * PI_ * u;
+    switch (s->type) {
+    case SHAPE_SPHERE: {
+        double ph = PI_ * v;
+        return v3_scale(v3(sin(ph) * cos(th), sin(ph) * sin(th), cos(ph)), s->radius);
+    }
+    case SHAPE_CAPSULE: {
+        double r = s->radius, hh = s->half_height;
+        if (k == 0) return v3(r * cos(th), r * sin(th), (2 * v - 1) * hh);
+        double ph = 0.5 * PI_ * v, sg = k == 1 ? 1 : -1;
+        return v3(r * sin(ph) * cos(th), r * sin(ph) * sin(th), sg * (hh + r * cos(ph)));
+    }
+    case SHAPE_CYLINDER: {
+        double r = s->radius, hh = s->half_height;
+        if (k == 0) return v3(r * cos(th), r * sin(th), (2 * v - 1) * hh);
+        return v3(r * v * cos(th), r * v * sin(th), k == 1 ? hh : -hh);
+    }
+    default: {
+        vec3 h = s->half_extents;
+        if (s->type == SHAPE_HULL) {
+            h = v3_zero();
+            for (int i = 0; i < s->hull->vertex_count; i++) h = v3_max(h, v3_abs(s->hull->vertices[i]));
+        }
+        int ax = k / 2;
+        double c[3], e[3] = {h.x, h.y, h.z};
+        c[ax] = (k & 1) ? -e[ax] : e[ax];
+        c[(ax + 1) % 3] = (2 * u - 1) * e[(ax + 1) % 3];
+        c[(ax + 2) % 3] = (2 * v - 1) * e[(ax + 2) % 3];
+        return v3(c[0], c[1], c[2]);
+    }
+    }
+}
+
+/* min over a's exact surface of b's exact signed distance: a 32 x 32 grid on
+ * each piece, then a pattern search from the best three cells. */
+static double surface_min_sdf(const shape *a, xform xa, const shape *b, xform xb)
+{
+    enum { N = 32 };
+    double best = INFINITY;
+    for (int k = 0; k < surface_pieces(a); k++) {
+        double su[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, sd[3] = {INFINITY, INFINITY, INFINITY};
+        for (int i = 0; i <= N; i++)
+            for (int j = 0; j <= N; j++) {
+                double u = (double)i / N, v = (double)j / N;
+                double d = exact_sdf(b, xb, xf_point(xa, surface_point(a, k, u, v)));
+                for (int t = 0; t < 3; t++)
+                    if (d < sd[t]) {
+                        for (int q = 2; q > t; q--) { sd[q] = sd[q - 1]; su[q] = su[q - 1]; sv[q] = sv[q - 1]; }
+                        sd[t] = d; su[t] = u; sv[t] = v;
+                        break;
+                    }
+            }
+        for (int t = 0; t < 3; t++) {
+            double u = su[t], v = sv[t], d = sd[t], step = 1.0 / N;
+            for (int it = 0; it < 200 && step > 1e-13; it++) {
+                int moved = 0;
+                for (int du = -1; du <= 1; du++)
+                    for (int dv = -1; dv <= 1; dv++) {
+                        if (!du && !dv) continue;
+                        double nu = fmin(1, fmax(0, u + du * step)), nv = fmin(1, fmax(0, v + dv * step));
+                        double nd = exact_sdf(b, xb, xf_point(xa, surface_point(a, k, nu, nv)));
+                        if (nd < d) { d = nd; u = nu; v = nv; moved = 1; }
+                    }
+                if (!moved) step *= 0.5;
+            }
+            best = fmin(best, d);
+        }
+    }
+    return best;
+}
+
+/* The signed gap between a and b by the brute force: the distance when apart,
+ * negative when they overlap. */
+static double brute_gap(const shape *a, xform xa, const shape *b, xform xb)
+{
+    return fmin(surface_min_sdf(a, xa, b, xb), surface_min_sdf(b, xb, a, xa));
+}
+
+typedef struct cyl_stats { int poses, apart, touching, deep; double worst_early, worst_moved; } cyl_stats;
+
+static void check_cylinder_pose(const shape *a, xform xa, const shape *b, xform xb, double d, double spec,
+                                const char *what, cyl_stats *st)
+{
+    collide_cache cache;
+    memset(&cache, 0, sizeof cache);
+    cache.feature = -1;
+    manifold m;
+    collide(a, xa, b, xb, spec, &cache, &m);
+    st->poses++;
+    if (d > spec + 1e-6) {
+        if (m.count != 0) print_error("%s: %d points at distance %.6f beyond the look-ahead\n", what, m.count, d);
+        assert_int_equal(m.count, 0);
+        return;
+    }
+    if (d > 1e-6) st->apart++;
+    else if (d > -1e-3) st->touching++;
+    else st->deep++;
+    if (d < spec - 1e-6 && m.count == 0) print_error("%s: no point at distance %.6f\n", what, d);
+    if (d >= spec - 1e-6) return;
+    assert_true(m.count > 0);
+    assert_true(fabs(v3_len(m.normal) - 1) < 1e-9);
+    double smin = INFINITY;
+    for (int i = 0; i < m.count; i++) smin = fmin(smin, m.points[i].separation);
+    /* never more room than there is, nor less by more than a face's preference (1 mm) */
+    if (smin > fmax(d, 0) + 1e-6 || (d > 0 && smin < d - 1e-3 - 1e-6))
+        print_error("%s: separation %.7f, brute-force gap %.7f\n", what, smin, d);
+    assert_true(smin <= fmax(d, 0) + 1e-6);
+    if (d > 0) assert_true(smin >= d - 1e-3 - 1e-6);
+    if (d > 0) st->worst_early = fmax(st->worst_early, d - smin);
+    /* a moved along the normal by the separation: touching (not apart by more
+     * than the face preference, not overlapping) */
+    xform moved = {v3_madd(xa.p, smin, m.normal), xa.q};
+    double dm = brute_gap(a, moved, b, xb);
+    if (dm < -1e-6 || dm > 1e-3 + 1e-6) print_error("%s: moved by the separation %.7f along the normal, gap %.7f\n", what, smin, dm);
+    assert_true(dm >= -1e-6 && dm <= 1e-3 + 1e-6);
+    st->worst_moved = fmax(st->worst_moved, fabs(dm));
+    /* every point half its separation from a surface: on the true shapes */
+    for (int i = 0; i < m.count; i++) {
+        vec3 p = m.points[i].point;
+        double sp = m.points[i].separation;
+        double on = fmin(fabs(exact_sdf(a, xa, v3_madd(p, -0.5 * sp, m.normal))),
+                         fabs(exact_sdf(b, xb, v3_madd(p, 0.5 * sp, m.normal))));
+        if (on > 1e-6) print_error("%s: point %d is %.2e from both surfaces\n", what, i, on);
+        assert_true(on <= 1e-6);
+    }
+}
+
+/* A cylinder against a sphere, box, capsule, cylinder and box-shaped hull in
+ * random sizes and orientations, brought to touching along a random line
+ * (GJK places them; every check is on the brute force), then set apart or
+ * pushed in, both argument orders. */
+static void test_cylinder_pairs_against_brute_force(void **state)
+{
+    (void)state;
+    uint64_t r = 0x9e3779b97f4a7c15ull;
+    const double offsets[] = {0.06, 0.02, 2e-3, 1e-4, -1e-4, -3e-3, -0.03};
+    const double spec = 0.04;
+    cyl_stats st = {0, 0, 0, 0, 0, 0};
+    for (int t = 0; t < 5; t++)
+        for (int rep = 0; rep < 12; rep++) {
+            double s1 = 0.2 + 0.8 * rnd(&r), s2 = 0.2 + 0.8 * rnd(&r), s3 = 0.2 + 0.8 * rnd(&r);
+            shape cy = cylinder(0.5 * s1, 0.5 * s2), o;
+            switch (t) {
+            case 0: o = sphere(0.5 * s3); break;
+            case 1: o = box(0.5 * s3, 0.3 * s1, 0.4 * s2); break;
+            case 2: o = capsule(0.3 * s3, 0.4 * s1); break;
+            case 3: o = cylinder(0.4 * s3, 0.3 * s2 + 0.1); break;
+            default: o = box_hull(v3(0.4 * s3, 0.5 * s1, 0.3 * s2)); break;
+            }
+            vec3 ax = v3_normalize(v3(2 * rnd(&r) - 1, 2 * rnd(&r) - 1, 2 * rnd(&r) - 1));
+            vec3 bx = v3_normalize(v3(2 * rnd(&r) - 1, 2 * rnd(&r) - 1, 2 * rnd(&r) - 1));
+            /* poses by rep % 4: standing, lying (the flat and line contacts),
+             * random, tilted 0.1 .. 0.7 rad (on its rim) over the other */
+            int kind = rep % 4, aligned = kind != 2;
+            double qa = kind == 0 ? 0 : kind == 1 ? 0.5 * PI_ : kind == 2 ? 2 * PI_ * rnd(&r) : 0.1 + 0.6 * rnd(&r);
+            vec3 tilt_axis = v3_normalize(v3(cos(2 * PI_ * rnd(&r)), sin(2 * PI_ * rnd(&r)), 0));
+            xform xc = {v3(0, 0, 0), q_axis_angle(kind < 2 ? v3(1, 0, 0) : kind == 3 ? tilt_axis : ax, qa)};
+            xform xo = {v3(0, 0, 0), aligned ? q_identity() : q_axis_angle(bx, 2 * PI_ * rnd(&r))};
+            vec3 dir = aligned ? v3(0.3 * (2 * rnd(&r) - 1), 0.3 * (2 * rnd(&r) - 1), 1) : v3(2 * rnd(&r) - 1, 2 * rnd(&r) - 1, 2 * rnd(&r) - 1);
+            dir = v3_normalize(dir);
+            double lo = 0, hi = 4;
+            for (int it = 0; it < 60; it++) {
+                double mid = 0.5 * (lo + hi);
+                xform x = xo;
+                x.p = v3_scale(dir, mid);
+                gjk_proxy pa = {&cy, NULL, 0, xc}, pb = {&o, NULL, 0, x};
+                if (gjk_distance(&pa, &pb).overlap) lo = mid;
+                else hi = mid;
+            }
+            /* far from the origin too */
+            vec3 far = rep % 3 == 2 ? v3(1e4, -2e4, 3e3) : v3_zero();
+            for (size_t k = 0; k < sizeof offsets / sizeof offsets[0]; k++) {
+                xform x = xo, c = xc;
+                /* offsets along dir are not gaps: the brute force says what they are */
+                x.p = v3_add(far, v3_scale(dir, hi + offsets[k]));
+                c.p = far;
+                double d = brute_gap(&cy, c, &o, x);
+                char what[96];
+                snprintf(what, sizeof what, "cylinder against %s rep %d offset %g", type_names[o.type], rep, offsets[k]);
+                check_cylinder_pose(&cy, c, &o, x, d, spec, what, &st);
+                snprintf(what, sizeof what, "%s against cylinder rep %d offset %g", type_names[o.type], rep, offsets[k]);
+                check_cylinder_pose(&o, x, &cy, c, d, spec, what, &st);
+            }
+            if (o.type == SHAPE_HULL) hull_free(o.hull);
+        }
+    print_message("cylinder pairs: %d poses (%d apart within the look-ahead, %d touching, %d deep); separation at most "
+                  "%.2e m below the brute-force gap; moved by it along the normal, %.2e m from touching\n",
+                  st.poses, st.apart, st.touching, st.deep, st.worst_early, st.worst_moved);
 }
 
 int main(void)
@@ -1054,6 +1272,7 @@ int main(void)
         cmocka_unit_test(test_box_plane),
         cmocka_unit_test(test_box_box),
         cmocka_unit_test(test_cylinder_pairs),
+        cmocka_unit_test(test_cylinder_pairs_against_brute_force),
         cmocka_unit_test(test_hull_pairs),
         cmocka_unit_test(test_random_box_box_against_brute_force),
         cmocka_unit_test(test_hull_boxes_agree_with_box_path),
