@@ -6,6 +6,17 @@
 
 #include "constraint.h"
 
+/* A manifold's normal rows solved as one block (contact_solver.c): built
+ * once a step for an unlocked manifold of 2-4 points, one per constraint
+ * in the step's block (step_context.blocks, indexed as the constraints). */
+typedef struct contact_block {
+    double K[4][4];              /* J M^-1 J^T of the normal rows */
+    double inv_soft[4][4];       /* (K + C + E)^-1: every row soft */
+    double inv_rigid[4][4];      /* (K + E)^-1: every row rigid */
+    double shock_K[4][4], shock_inv[4][4]; /* the shock pass's, built at its first call */
+    int ready, shock_ready;      /* 0: sweep the rows one by one */
+} contact_block;
+
 /* Anchors, rows, effective masses, warm impulses and the approach velocity
  * of one manifold's points; returns its deepest overlap. */
 double contact_prepare(contact_constraint *c, const step_context *ctx);

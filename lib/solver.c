@@ -579,7 +579,11 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
                        sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
-    if (!array_reserve(&s->solver.block, &s->solver.block_capacity, (int)con_bytes, 1)) return 0;
+    /* last, after the lists: the scalar passes' blocks (contact_prepare
+     * fills those of the manifolds it prepares; the wide ones' stay untouched) */
+    size_t block_at = (con_bytes + 63) / 64 * 64;
+    size_t all_bytes = block_at + sizeof(contact_block) * (size_t)ncon;
+    if (!array_reserve(&s->solver.block, &s->solver.block_capacity, (int)all_bytes, 1)) return 0;
     contact_constraint *cc = s->solver.block;
     constraint_point *point_pool = (constraint_point *)(cc + ncon);
     work->shock_order = (int *)(point_pool + npoints);
@@ -596,6 +600,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
     for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;
     ctx->constraints = cc;
+    ctx->blocks = (contact_block *)((char *)s->solver.block + block_at);
     ctx->constraint_count = ncon;
     ctx->point_count = npoints;
     return 1;

@@ -53,6 +53,7 @@ typedef struct step_context {
     /* constraints (the solver's build stage), one per touching manifold */
     struct contact_constraint *constraints;
     int constraint_count, point_count;
+    struct contact_block *blocks; /* per constraint: its normal rows as one block (contact_solver.c) */
 } step_context;
 
 /* The settings part from the world's def; no bodies or constraints yet. */
