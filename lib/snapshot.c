@@ -1118,12 +1118,27 @@ typedef struct mix_memo {
     const int *class_of;    /* per slot */
     double mix[MIX_MEMO_CLASSES * MIX_MEMO_CLASSES][3];
     unsigned char have[MIX_MEMO_CLASSES * MIX_MEMO_CLASSES];
+    double reach[MIX_MEMO_CLASSES]; /* shape_bounding_radius of each class's shape */
+    unsigned char have_reach[MIX_MEMO_CLASSES];
 } mix_memo;
 
 static void mix_memo_init(mix_memo *m, const int *class_of)
 {
     m->class_of = class_of;
     memset(m->have, 0, sizeof m->have);
+    memset(m->have_reach, 0, sizeof m->have_reach);
+}
+
+/* A body's bounding radius (its class's shape's: the same bits). */
+static double body_reach(const body_store *s, mix_memo *memo, int slot)
+{
+    int k = memo ? memo->class_of[slot] : MIX_MEMO_CLASSES;
+    if (k >= MIX_MEMO_CLASSES) return shape_bounding_radius(&s->shapes[slot]);
+    if (!memo->have_reach[k]) {
+        memo->reach[k] = shape_bounding_radius(&s->shapes[slot]);
+        memo->have_reach[k] = 1;
+    }
+    return memo->reach[k];
 }
 
 static contact_guess guess_contact(const body_store *s, mix_memo *memo, const xform *pose, int a, int b, uint32_t sub)
@@ -1184,7 +1199,7 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
         int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
         xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
-        double reach = (c->flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[b]) : 0.0;
+        double reach = (c->flags & CONTACT_APART) ? body_reach(s, memo, b) : 0.0;
         vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
         unsigned bits = contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a);
         /* every point where the reader predicts it (a settled pile's kept
@@ -1808,7 +1823,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis") : v3(0, 0, 0);
         /* the predictions, as the writer made them */
         xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
-        double reach = (flags & CONTACT_APART) ? shape_bounding_radius(&s->shapes[sb]) : 0.0;
+        double reach = (flags & CONTACT_APART) ? body_reach(s, memo, sb) : 0.0;
         vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
         if (posed) {
             c->rel_pose.p = (bits & CREC_POSE) ? get_coded_v3(r, rel.p, "contact pose") : rel.p;
