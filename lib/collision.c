@@ -378,8 +378,8 @@ COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i
  * whose bounds no longer overlap is removed when may_remove (returns 0:
  * index i now holds another contact), else only emptied. a, b: the
  * bodies' slots, awake_a, awake_b: body_awake of each (the caller's test). */
-static int update_contact(carom_world *w, const step_context *ctx, int i, int a, int b, int awake_a, int awake_b,
-                          double reuse, int may_remove, int *woken)
+COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i, int a, int b, int awake_a, int awake_b,
+                                  double reuse, int may_remove, int *woken)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
