@@ -1052,6 +1052,43 @@ static face_axis best_face(const shape *s, const poly *p, const shape *o, xform 
     return fa;
 }
 
+/* Distance from p inside s (poly p for a box or hull) to its surface, or -1
+ * when p is not inside. */
+static double interior_distance(const shape *s, xform x, const poly *pp, vec3 p)
+{
+    if (s->type == SHAPE_CYLINDER) {
+        vec3 l = xf_inv_point(x, p);
+        double d = dmin(s->radius - sqrt(l.x * l.x + l.y * l.y), s->half_height - fabs(l.z));
+        return d >= 0 ? d : -1;
+    }
+    if (!pp) return -1;
+    double d = 1e300;
+    for (int f = 0; f < pp->nf; f++) d = dmin(d, pp->fd[f] - v3_dot(pp->fn[f], p));
+    return d >= 0 ? d : -1;
+}
+
+/* 1 when face fx of s is, within FACE_TOLERANCE, the best axis of all: the
+ * other shape's deepest point q along it certifies it. Apart: q over the
+ * face, so that point of the face is as far from q as the gap (the gap is
+ * always a lower bound of the distance). Overlapping: q inside s, at least
+ * -gap - FACE_TOLERANCE from its surface, so no translation shorter than
+ * that separates them (the face's gap is a lower bound of minus the depth). */
+static int face_is_exact(const shape *s, xform xs, const poly *p, face_axis fx, const shape *o, xform xo)
+{
+    vec3 n = p->fn[fx.face];
+    vec3 q = support_p(o, xo, v3_neg(n));
+    if (fx.gap > 0) {
+        int rc = p->fcount[fx.face];
+        for (int e = 0; e < rc; e++) {
+            vec3 a = p->v[p->fv[p->ffirst[fx.face] + e]], b = p->v[p->fv[p->ffirst[fx.face] + (e + 1) % rc]];
+            vec3 side = v3_cross(v3_sub(b, a), n); /* outward, not unit */
+            if (v3_dot(side, v3_sub(q, a)) > 0) return 0;
+        }
+        return 1;
+    }
+    return interior_distance(s, xs, p, q) >= -fx.gap - FACE_TOLERANCE;
+}
+
 static int mpr(const shape *a, xform xa, const shape *b, xform xb, vec3 *n, vec3 *pos)
 {
     ccd_t ccd;
@@ -1115,13 +1152,26 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
     poly pa_buf, pb_buf;
     const poly *pa = poly_from_shape(&pa_buf, sa, xa) ? &pa_buf : NULL;
     const poly *pb = poly_from_shape(&pb_buf, sb, xb) ? &pb_buf : NULL;
-    /* the true normal and gap: GJK apart, MPR overlapping */
-    gjk_proxy ga = {sa, NULL, 0, xa}, gb = {sb, NULL, 0, xb};
-    gjk_result g = gjk_distance(&ga, &gb);
+    /* face axes of a (outward: a towards b) and of b (outward: b towards a),
+     * their gaps exact (the other shape's true support) */
+    face_axis fa = best_face(sa, pa, sb, xb), fb = best_face(sb, pb, sa, xa);
+    double face_gap = dmax(fa.gap, fb.gap);
+    if (face_gap >= spec) { /* an axis separates them beyond the look-ahead */
+        m->normal = fa.gap >= fb.gap ? pa->fn[fa.face] : v3_neg(pb->fn[fb.face]);
+        return;
+    }
+    /* a face whose gap is the true one needs no GJK: the face path below */
+    int certified = (fa.face >= 0 && face_is_exact(sa, xa, pa, fa, sb, xb)) ||
+                    (fb.face >= 0 && face_is_exact(sb, xb, pb, fb, sa, xa));
+    /* else the true normal and gap: GJK apart, MPR overlapping */
+    gjk_result g;
+    memset(&g, 0, sizeof g);
     vec3 n0 = v3(0, 0, 1), p0 = v3_zero();
-    double d0;
+    double d0 = face_gap;
     int have_n0 = 1;
-    if (!g.overlap) {
+    if (certified) {
+        have_n0 = 0;
+    } else if (!(g = gjk_distance(&(gjk_proxy){sa, NULL, 0, xa}, &(gjk_proxy){sb, NULL, 0, xb})).overlap) {
         if (g.lower_bound >= spec || g.distance >= spec) {
             m->normal = v3_len2(g.normal) > 0.5 ? g.normal : g.lower_normal;
             return;
@@ -1148,10 +1198,7 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
             if (gi > d0) { d0 = gi; n0 = cand_n[i]; }
         }
     }
-    if (!have_n0) d0 = -1e300;
-    /* face axes of a (outward: a towards b) and of b (outward: b towards a) */
-    face_axis fa = best_face(sa, pa, sb, xb), fb = best_face(sb, pb, sa, xa);
-    double face_gap = dmax(fa.gap, fb.gap);
+    if (!have_n0) d0 = certified ? face_gap : -1e300;
     if (g.overlap && have_n0) {
         /* refined to the least penetration near the best direction (GJK
          * backed off, above: a face clearly better than MPR's direction is
@@ -1161,7 +1208,6 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
         p0 = v3_madd(support_p(sb, xb, v3_neg(n0)), -0.5 * d0, n0);
     }
     if (face_gap >= d0 - FACE_TOLERANCE && (fa.face >= 0 || fb.face >= 0)) {
-        if (face_gap >= spec) { m->normal = fa.gap >= fb.gap ? pa->fn[fa.face] : v3_neg(pb->fn[fb.face]); return; }
         int use_b = fa.face < 0 || (fb.face >= 0 && fb.gap > fa.gap + KEEP_TOLERANCE);
         if (fa.face >= 0 && fb.face >= 0 && cache->feature >= 0 && fabs(fb.gap - fa.gap) <= KEEP_TOLERANCE)
             use_b = cache->flip;
