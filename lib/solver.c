@@ -80,8 +80,10 @@ typedef struct body_step {
 } body_step;
 
 /* Keeps plane-locked bodies in their plane: in-plane velocity, spin about the normal. */
-static void project_planar(const body_store *bs, const step_context *ctx)
+static void project_planar(const carom_world *w, const step_context *ctx)
 {
+    const body_store *bs = &w->bodies;
+    if (!w->scratch.solver.planar) return; /* no awake body is locked to a plane (gather_bodies) */
     for (int k = 1; k < ctx->body_count; k++) {
         int slot = ctx->body_slot[k];
         if (!(bs->flags[slot] & BODY_LOCK_PLANE)) continue;
@@ -209,7 +211,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     s->delta_position[0] = v3_zero();
     s->delta_rotation[0] = v3_zero();
     s->body_slot[0] = -1;
-    int nb = 1;
+    int nb = 1, planar = 0;
     for (int i = 0; i < bs->count; i++) {
         if (bs->type[i] == CAROM_BODY_STATIC || !(bs->flags[i] & BODY_AWAKE)) continue;
         int k = nb++;
@@ -226,7 +228,9 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         s->delta_position[k] = v3_zero();
         s->delta_rotation[k] = v3_zero();
         body_step_of(bs, i, &bodies[k], ctx, &motion[k]);
+        planar |= (bs->flags[i] & BODY_LOCK_PLANE) != 0;
     }
+    s->solver.planar = planar;
     ctx->bodies = bodies;
     ctx->dp = s->delta_position;
     ctx->dq = s->delta_rotation;
@@ -733,7 +737,7 @@ static void integrate_velocities(carom_world *w, const step_context *ctx)
 {
     body_job j = {w, ctx, NULL};
     tasks_run(ctx->tasks, ctx->body_count - 1, BODY_MIN_RANGE, integrate_velocities_range, &j);
-    project_planar(&w->bodies, ctx);
+    project_planar(w, ctx);
 }
 
 static void warm_start(const step_context *ctx, const solver_work *work)
@@ -768,7 +772,7 @@ static void solve(carom_world *w, const step_context *ctx, const solver_work *wo
         for (int it = 0; it < ctx->iterations; it++) solve_pass(ctx, work, 1, 0);
         shock_pass(ctx, work, 1, 0);
     }
-    project_planar(&w->bodies, ctx);
+    project_planar(w, ctx);
 }
 
 /* Rotation over one sub-step: between impulses L = I w is what holds, so a
@@ -841,7 +845,7 @@ static void relax(carom_world *w, const step_context *ctx, const solver_work *wo
     int hold = last && work->impacts;
     for (int it = 0; it < ctx->relax_iterations; it++) solve_pass(ctx, work, 0, hold);
     shock_pass(ctx, work, 0, hold);
-    project_planar(&w->bodies, ctx);
+    project_planar(w, ctx);
 }
 
 static void store_wide(const step_context *ctx, const solver_work *work)
