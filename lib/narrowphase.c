@@ -1052,6 +1052,76 @@ static face_axis best_face(const shape *s, const poly *p, const shape *o, xform 
     return fa;
 }
 
+/* The unit circle at the prism's 16 vertex angles (constant data). */
+static const double cyl_rim[CYL_SIDES][2] = {
+    {1, 0},
+    {0.92387953251128674, 0.38268343236508978},
+    {0.70710678118654757, 0.70710678118654746},
+    {0.38268343236508984, 0.92387953251128674},
+    {6.123233995736766e-17, 1},
+    {-0.38268343236508973, 0.92387953251128674},
+    {-0.70710678118654746, 0.70710678118654757},
+    {-0.92387953251128674, 0.38268343236508989},
+    {-1, 1.2246467991473532e-16},
+    {-0.92387953251128685, -0.38268343236508967},
+    {-0.70710678118654768, -0.70710678118654746},
+    {-0.38268343236509034, -0.92387953251128652},
+    {-1.8369701987210297e-16, -1},
+    {0.38268343236509, -0.92387953251128663},
+    {0.70710678118654735, -0.70710678118654768},
+    {0.92387953251128652, -0.38268343236509039}};
+
+/* A cylinder's rims and caps only, as poly_from_cylinder numbers them
+ * (vertices i bottom, CYL_SIDES + i top; faces CYL_SIDES top and
+ * CYL_SIDES + 1 bottom); the side facets, which nothing here reads, are
+ * left empty. No trigonometry: a table and the three rotated axes. */
+static void cylinder_caps(poly *p, const shape *s, xform x)
+{
+    const int n = CYL_SIDES;
+    vec3 ex = q_rotate(x.q, v3(1, 0, 0)), ey = q_rotate(x.q, v3(0, 1, 0)), ez = q_rotate(x.q, v3(0, 0, 1));
+    vec3 top = v3_madd(x.p, s->half_height, ez), bot = v3_madd(x.p, -s->half_height, ez);
+    p->nv = 2 * n; p->nf = n + 2; p->ne = 0;
+    for (int i = 0; i < n; i++) {
+        vec3 off = v3_add(v3_scale(ex, s->radius * cyl_rim[i][0]), v3_scale(ey, s->radius * cyl_rim[i][1]));
+        p->v[i] = v3_add(bot, off);
+        p->v[n + i] = v3_add(top, off);
+        p->fn[i] = v3_zero(); p->fd[i] = 0; p->ffirst[i] = 0; p->fcount[i] = 0;
+    }
+    p->fn[n] = ez; p->ffirst[n] = 0; p->fcount[n] = n;
+    p->fn[n + 1] = v3_neg(ez); p->ffirst[n + 1] = n; p->fcount[n + 1] = n;
+    for (int i = 0; i < n; i++) { p->fv[i] = n + i; p->fv[n + i] = n - 1 - i; }
+    p->fd[n] = v3_dot(ez, top);
+    p->fd[n + 1] = -v3_dot(ez, bot);
+    p->center = x.p;
+}
+
+/* Signed distance from world point c to the cylinder s at x (negative
+ * inside), and the unit normal out of the cylinder at its nearest surface
+ * point (the direction from that point to c when outside). */
+static double point_cylinder(const shape *s, xform x, vec3 c, vec3 *n)
+{
+    vec3 l = xf_inv_point(x, c);
+    double rho = sqrt(l.x * l.x + l.y * l.y);
+    double ux = rho > 1e-300 ? l.x / rho : 1.0, uy = rho > 1e-300 ? l.y / rho : 0.0;
+    double dr = rho - s->radius, dz = fabs(l.z) - s->half_height, sz = l.z < 0 ? -1.0 : 1.0;
+    vec3 nl;
+    double d;
+    if (dr > 0 || dz > 0) {
+        double qr = dmin(rho, s->radius), qz = dmax(-s->half_height, dmin(s->half_height, l.z));
+        vec3 v = v3(l.x - qr * ux, l.y - qr * uy, l.z - qz);
+        d = v3_len(v);
+        nl = d > 1e-300 ? v3_scale(v, 1.0 / d) : (dr > dz ? v3(ux, uy, 0) : v3(0, 0, sz));
+    } else if (dr > dz) {
+        d = dr;
+        nl = v3(ux, uy, 0);
+    } else {
+        d = dz;
+        nl = v3(0, 0, sz);
+    }
+    *n = q_rotate(x.q, nl);
+    return d;
+}
+
 /* Distance from p inside s (poly p for a box or hull) to its surface, or -1
  * when p is not inside. */
 static double interior_distance(const shape *s, xform x, const poly *pp, vec3 p)
@@ -1150,8 +1220,11 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
     vec3 ref = xa0.p;
     xform xa = {v3_zero(), xa0.q}, xb = {v3_sub(xb0.p, ref), xb0.q};
     poly pa_buf, pb_buf;
-    const poly *pa = poly_from_shape(&pa_buf, sa, xa) ? &pa_buf : NULL;
-    const poly *pb = poly_from_shape(&pb_buf, sb, xb) ? &pb_buf : NULL;
+    const poly *pa = NULL, *pb = NULL;
+    if (sa->type == SHAPE_CYLINDER) { cylinder_caps(&pa_buf, sa, xa); pa = &pa_buf; }
+    else if (poly_from_shape(&pa_buf, sa, xa)) pa = &pa_buf;
+    if (sb->type == SHAPE_CYLINDER) { cylinder_caps(&pb_buf, sb, xb); pb = &pb_buf; }
+    else if (poly_from_shape(&pb_buf, sb, xb)) pb = &pb_buf;
     /* face axes of a (outward: a towards b) and of b (outward: b towards a),
      * their gaps exact (the other shape's true support) */
     face_axis fa = best_face(sa, pa, sb, xb), fb = best_face(sb, pb, sa, xa);
@@ -1168,9 +1241,22 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
     memset(&g, 0, sizeof g);
     vec3 n0 = v3(0, 0, 1), p0 = v3_zero();
     double d0 = face_gap;
-    int have_n0 = 1;
+    int have_n0 = 1, exact = 0;
+    const shape *sph = sa->type == SHAPE_SPHERE ? sa : sb->type == SHAPE_SPHERE ? sb : NULL;
     if (certified) {
         have_n0 = 0;
+    } else if (sph) {
+        /* a sphere: its centre's signed distance to the cylinder, in closed form */
+        int sa_is = sph == sa;
+        const shape *cyl = sa_is ? sb : sa;
+        xform xc = sa_is ? xb : xa;
+        vec3 c = sa_is ? xa.p : xb.p, nc;
+        double dist = point_cylinder(cyl, xc, c, &nc); /* nc: out of the cylinder, towards c */
+        d0 = dist - sph->radius;
+        n0 = sa_is ? v3_neg(nc) : nc;
+        p0 = v3_madd(c, -(dist - 0.5 * d0), nc);
+        exact = 1;
+        if (d0 >= spec) { m->normal = n0; return; }
     } else if (!(g = gjk_distance(&(gjk_proxy){sa, NULL, 0, xa}, &(gjk_proxy){sb, NULL, 0, xb})).overlap) {
         if (g.lower_bound >= spec || g.distance >= spec) {
             m->normal = v3_len2(g.normal) > 0.5 ? g.normal : g.lower_normal;
@@ -1199,7 +1285,7 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
         }
     }
     if (!have_n0) d0 = certified ? face_gap : -1e300;
-    if (g.overlap && have_n0) {
+    if (g.overlap && have_n0 && !exact) {
         /* refined to the least penetration near the best direction (GJK
          * backed off, above: a face clearly better than MPR's direction is
          * not enough, MPR's depth is up to 100 times the true one); b's
@@ -1260,7 +1346,7 @@ static void cylinder_contact(const shape *sa, xform xa0, const shape *sb, xform 
     }
     /* round against round or an edge: the closest points, or two parallel lines' overlap */
     cache->feature = -1;
-    if (!g.overlap && d0 < NEAR_GAP) {
+    if (!g.overlap && !exact && d0 < NEAR_GAP) {
         /* GJK's normal between surfaces almost touching is the direction of a
          * tiny vector (0.1 degree off between resting parallel logs): backed
          * off, it is well conditioned */
