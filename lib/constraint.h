@@ -59,8 +59,9 @@ typedef struct contact_constraint {
     int count;
     int level;                   /* shock propagation: lower of the two body levels */
     int wide_batch, wide_lane;   /* solver_wide.c's batch and lane, or -1: scalar passes */
-    /* plane-locked bodies (1: a, 2: b); such a manifold takes the scalar
-     * passes, which keep the locked bodies' velocities in their planes */
+    /* plane-locked bodies (1: a, 2: b): every pass keeps the locked bodies'
+     * velocities in their planes after each row (the wide ones in batches of
+     * their own) */
     int locked;
     vec3 n, t1, t2;
     double friction, restitution;

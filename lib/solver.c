@@ -57,6 +57,7 @@ typedef struct solver_work {
     int clamped;                 /* velocities clamped this step */
     double max_penetration;
     int points;
+    int locked;                  /* constraints with a plane-locked body */
 } solver_work;
 
 /* What the sub-steps read of a solver body, computed once per step from the
@@ -552,12 +553,16 @@ static int sort_touching(carom_world *w, const step_context *ctx)
 
 /* The few manifolds with a plane-locked body or rolling resistance get
  * their extra fields (constraint_extra), in constraint order. */
-static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon)
+static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon, int *locked)
 {
     solver_memory *sm = &w->scratch.solver;
     const body_store *bs = &w->bodies;
-    int n = 0;
-    for (int k = 0; k < ncon; k++) n += cc[k].locked || cc[k].rolling > 0.0;
+    int n = 0, nlocked = 0;
+    for (int k = 0; k < ncon; k++) {
+        n += cc[k].locked || cc[k].rolling > 0.0;
+        nlocked += cc[k].locked != 0;
+    }
+    *locked = nlocked;
     if (n == 0) return 1;
     if (!array_reserve(&sm->extra, &sm->extra_capacity, n, sizeof(constraint_extra))) return 0;
     constraint_extra *x = sm->extra;
@@ -600,7 +605,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     }
     constraint_job job = {w, ctx, cc, NULL};
     tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
-    if (!attach_extras(w, ctx, cc, ncon)) return 0;
+    if (!attach_extras(w, ctx, cc, ncon, &work->locked)) return 0;
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
     for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;
     ctx->constraints = cc;
@@ -636,7 +641,8 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     work->scalar = NULL;
     work->scalar_count = ctx->constraint_count;
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
-    work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count, ctx->body_count);
+    work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count,
+                           work->locked, ctx->body_count);
     if (!work->wide) return 0;
     work->scalar_count = wide_overflow(work->wide, &work->scalar);
     return 1;

@@ -6,8 +6,11 @@
  * that share no moving body in one colour; within a colour, manifolds with
  * the same number of points are packed four to a batch, field by field. Each
  * manifold is still solved point by point exactly as in solver.c; only the
- * order between manifolds becomes colour by colour. Manifolds beyond the last
- * colour keep the scalar passes (contact_solver.c). The AVX2 and SSE2 builds
+ * order between manifolds becomes colour by colour. Manifolds with a
+ * plane-locked body take batches of their own (after a colour's free ones),
+ * whose passes keep the locked velocities in their planes. Manifolds beyond
+ * the last colour, or with rolling resistance, keep the scalar passes
+ * (contact_solver.c). The AVX2 and SSE2 builds
  * of the passes come from one source (WIDE_PASSES below). */
 #include <stdint.h>
 #include <stdlib.h>
@@ -47,6 +50,12 @@ typedef struct wide_point {
     lane_t ra_t[2][3], rb_t[2][3], ia_t[2][3], ib_t[2][3];
 } wide_point;
 
+/* A locked batch's plane normals per lane (zero: a free body), solver.c's
+ * constraint_extra lock_a and lock_b. */
+typedef struct wide_lock {
+    lane_t a[3], b[3];
+} wide_lock;
+
 typedef struct wide_batch {
     lane_t n[3], t1[3], t2[3];
     lane_t friction, bias_rate, mass_scale, impulse_scale;
@@ -56,16 +65,20 @@ typedef struct wide_batch {
     int count;                   /* points per manifold, the same in every lane */
     int lanes;                   /* lanes in use */
     int first;                   /* first of `count` wide points */
+    int lock;                    /* its manifolds' plane normals in the set's locks, or -1: no body locked */
 } wide_batch;
 
 struct wide_set {
     wide_batch *batches;
     wide_point *points;
+    wide_lock *locks;            /* locked batches' plane normals */
     int *overflow;               /* constraints with no colour: scalar passes */
     double *deepest;             /* per batch: its deepest overlap (prepare) */
     int batch_count, overflow_count;
     int color_first[WIDE_COLORS + 1]; /* colour c's batches: color_first[c] .. color_first[c + 1] - 1 */
+    int color_locked[WIDE_COLORS];    /* colour c's locked batches: color_locked[c] .. color_first[c + 1] - 1 */
     int avx2;                    /* run the AVX2 build of the passes */
+    int lock_kinds;              /* 2 when some manifold has a plane-locked body (buckets of their own), else 1 */
 };
 
 /* One build of the passes over the batches first .. last - 1 (WIDE_PASSES). */
@@ -74,12 +87,16 @@ typedef struct wide_passes {
                     int last);
     void (*warm)(const wide_set *ws, impulse_body *bodies, int first, int last);
     void (*solve)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first, int last);
+    /* the same over locked batches */
+    void (*warm_locked)(const wide_set *ws, impulse_body *bodies, int first, int last);
+    void (*solve_locked)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first,
+                         int last);
 } wide_passes;
 
 static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
 
 /* A lane's batch header: the manifold's bodies, basis and material. */
-static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint *c)
+static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const contact_constraint *c)
 {
     wb->a[l] = c->a;
     wb->b[l] = c->b;
@@ -89,6 +106,14 @@ static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint 
         wb->t1[d][l] = v3_get(c->t1, d);
         wb->t2[d][l] = v3_get(c->t2, d);
     }
+    if (wb->lock >= 0) {
+        wide_lock *lk = &ws->locks[wb->lock];
+        vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
+        for (int d = 0; d < 3; d++) {
+            lk->a[d][l] = v3_get(la, d);
+            lk->b[d][l] = v3_get(lb, d);
+        }
+    }
     wb->friction[l] = c->friction;
     wb->restitution[l] = c->restitution;
     wb->bias_rate[l] = c->soft.bias_rate;
@@ -96,24 +121,30 @@ static void fill_header(wide_batch *wb, int l, int ci, const contact_constraint 
     wb->impulse_scale[l] = c->soft.impulse_scale;
 }
 
-/* Per colour and point count: manifolds counted, then lanes filled, and the first batch. */
+/* Per colour, lock (1: a body is locked to a plane) and point count:
+ * manifolds counted, then lanes filled, and the first batch. A bucket's
+ * flat index is BUCKET(c, locked, n). */
+#define BUCKET(c, locked, n) (((c) * 2 + (locked)) * (MANIFOLD_MAX_POINTS + 1) + (n))
 typedef struct plan_buckets {
-    int count[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
-    int start[WIDE_COLORS][MANIFOLD_MAX_POINTS + 1];
+    int count[WIDE_COLORS * 2 * (MANIFOLD_MAX_POINTS + 1)];
+    int start[WIDE_COLORS * 2 * (MANIFOLD_MAX_POINTS + 1)];
 } plan_buckets;
 
 /* The set, its batches and points and the planner's scratch in one block
  * (grown, never shrunk), 64-byte aligned. */
-static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constraint *cc, int ncon, int nb,
-                             int **color, uint32_t **used)
+static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constraint *cc, int ncon, int nlocked,
+                             int nb, int **color, uint32_t **used)
 {
     /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
-    int max_batches = ncon / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
     int npoints = 0;
     for (int k = 0; k < ncon; k++) npoints += cc[k].count;
-    int max_wide_points = npoints / LANES + WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
+    int buckets = nlocked ? 2 : 1; /* locked manifolds have buckets of their own */
+    int max_batches = ncon / LANES + buckets * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
+    int max_locks = nlocked ? nlocked / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
+    int max_wide_points = npoints / LANES + buckets * WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
     size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
-                   align_up(sizeof(wide_point) * (size_t)max_wide_points) + align_up(sizeof(int) * (size_t)ncon) * 2 +
+                   align_up(sizeof(wide_point) * (size_t)max_wide_points) + align_up(sizeof(wide_lock) * (size_t)max_locks) +
+                   align_up(sizeof(int) * (size_t)ncon) * 2 +
                    align_up(sizeof(uint32_t) * (size_t)nb) + align_up(sizeof(double) * (size_t)max_batches);
     if (bytes > *capacity) {
         size_t cap = *capacity ? *capacity : 4096;
@@ -125,11 +156,14 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constra
     }
     char *base = (char *)(((uintptr_t)*mem + 63) & ~(uintptr_t)63);
     wide_set *ws = (wide_set *)base;
+    ws->lock_kinds = buckets;
     base += align_up(sizeof *ws);
     ws->batches = (wide_batch *)base;
     base += align_up(sizeof(wide_batch) * (size_t)max_batches);
     ws->points = (wide_point *)base;
     base += align_up(sizeof(wide_point) * (size_t)max_wide_points);
+    ws->locks = (wide_lock *)base;
+    base += align_up(sizeof(wide_lock) * (size_t)max_locks);
     ws->overflow = (int *)base;
     base += align_up(sizeof(int) * (size_t)ncon);
     ws->deepest = (double *)base;
@@ -141,8 +175,9 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constra
     return ws;
 }
 
-/* Greedy colouring; the static body 0 never blocks (it does not move). */
-static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int *color, uint32_t *used,
+/* Greedy colouring; the static body 0 never blocks (it does not move).
+ * bucket[k]: constraint k's bucket (BUCKET), or -1: the scalar passes. */
+static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int *bucket, uint32_t *used,
                             plan_buckets *pb)
 {
     memset(pb->count, 0, sizeof pb->count);
@@ -153,67 +188,77 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
         int c = 0;
         while (c < WIDE_COLORS && (taken >> c & 1u)) c++;
         cc[k].wide_batch = cc[k].wide_lane = -1;
-        if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1 || cc[k].locked || cc[k].rolling > 0.0) {
-            color[k] = -1;
+        if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1 || cc[k].rolling > 0.0) {
+            bucket[k] = -1;
             ws->overflow[ws->overflow_count++] = k;
             continue;
         }
-        color[k] = c;
         if (a) used[a] |= 1u << c;
         if (b) used[b] |= 1u << c;
-        pb->count[c][cc[k].count]++;
+        bucket[k] = BUCKET(c, cc[k].locked != 0, cc[k].count);
+        pb->count[bucket[k]]++;
     }
 }
 
 /* Batches in colour order; inside a colour, by point count. */
 static void lay_out_batches(wide_set *ws, plan_buckets *pb)
 {
-    int nbatch = 0, nwide = 0;
+    int nbatch = 0, nwide = 0, nlock = 0;
     for (int c = 0; c < WIDE_COLORS; c++) {
         ws->color_first[c] = nbatch;
-        for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
-            pb->start[c][n] = nbatch;
-            int batches = (pb->count[c][n] + LANES - 1) / LANES;
-            for (int i = 0; i < batches; i++) {
-                wide_batch *wb = &ws->batches[nbatch + i];
-                int first = nwide + i * n;
-                if (i == batches - 1 && pb->count[c][n] % LANES) {
-                    /* the part-full batch: empty lanes stay zero (no mass, no effect) */
-                    memset(wb, 0, sizeof *wb);
-                    memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
+        for (int locked = 0; locked < ws->lock_kinds; locked++) {
+            if (locked) ws->color_locked[c] = nbatch;
+            for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
+                int bk = BUCKET(c, locked, n);
+                pb->start[bk] = nbatch;
+                int batches = (pb->count[bk] + LANES - 1) / LANES;
+                for (int i = 0; i < batches; i++) {
+                    wide_batch *wb = &ws->batches[nbatch + i];
+                    int first = nwide + i * n;
+                    if (i == batches - 1 && pb->count[bk] % LANES) {
+                        /* the part-full batch: empty lanes stay zero (no mass, no effect) */
+                        memset(wb, 0, sizeof *wb);
+                        memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
+                    }
+                    wb->count = n;
+                    wb->first = first;
+                    wb->lock = -1;
+                    if (locked) {
+                        wb->lock = nlock;
+                        memset(&ws->locks[nlock++], 0, sizeof(wide_lock));
+                    }
                 }
-                wb->count = n;
-                wb->first = first;
+                nbatch += batches;
+                nwide += batches * n;
+                pb->count[bk] = 0; /* now: lanes filled so far */
             }
-            nbatch += batches;
-            nwide += batches * n;
-            pb->count[c][n] = 0; /* now: lanes filled so far */
         }
+        if (ws->lock_kinds == 1) ws->color_locked[c] = nbatch; /* none locked */
     }
     ws->color_first[WIDE_COLORS] = nbatch;
     ws->batch_count = nbatch;
 }
 
 /* Each coloured manifold into the next free lane of its bucket's batches. */
-static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int *color, plan_buckets *pb)
+static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int *bucket, plan_buckets *pb)
 {
     for (int k = 0; k < ncon; k++) {
-        int c = color[k];
-        if (c < 0) continue;
-        int n = cc[k].count, slot = pb->count[c][n]++;
-        wide_batch *wb = &ws->batches[pb->start[c][n] + slot / LANES];
-        fill_header(wb, slot % LANES, k, &cc[k]);
+        int bk = bucket[k];
+        if (bk < 0) continue;
+        int slot = pb->count[bk]++;
+        wide_batch *wb = &ws->batches[pb->start[bk] + slot / LANES];
+        fill_header(ws, wb, slot % LANES, k, &cc[k]);
         wb->lanes = slot % LANES + 1;
-        cc[k].wide_batch = pb->start[c][n] + slot / LANES;
+        cc[k].wide_batch = pb->start[bk] + slot / LANES;
         cc[k].wide_lane = slot % LANES;
     }
 }
 
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb)
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb)
 {
     int *color;
     uint32_t *used;
-    wide_set *ws = reserve_set(mem, capacity, cc, ncon, nb, &color, &used);
+    wide_set *ws = reserve_set(mem, capacity, cc, ncon, nlocked, nb, &color, &used);
     if (!ws) return NULL;
     plan_buckets pb;
     color_manifolds(ws, cc, ncon, color, used, &pb);
@@ -238,6 +283,12 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
 #define LANE_MAX(a, b) SELECT_LANES((a) > (b), a, b)
 #define LANE_MIN(a, b) SELECT_LANES((a) < (b), a, b)
 #define DOT3(a, b) ((a)[0] * (b)[0] + (a)[1] * (b)[1] + (a)[2] * (b)[2])
+/* keep_in_plane (constraint.h) per lane: v -= (v.l) l, l = 0 for a free body */
+#define KEEP_IN_PLANE(v, l)                                                    \
+    do {                                                                       \
+        lane_t neg_ = -DOT3(v, l);                                             \
+        for (int k_ = 0; k_ < 3; k_++) (v)[k_] = (v)[k_] + neg_ * (l)[k_];     \
+    } while (0)
 #define SET_LANES(dst, P0, P1, P2, P3, field)                                    \
     do {                                                                         \
         const double lanes_[LANES] = {(P0)->field, (P1)->field, (P2)->field, (P3)->field}; \
@@ -290,7 +341,11 @@ LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_
     }
 }
 
-LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body *bodies)
+/* `locked` (a constant in each inlined copy): the batch's manifolds have
+ * plane-locked bodies (lk their normals), whose velocities are kept in their
+ * planes after every row, as the scalar passes do. */
+LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body *bodies, const wide_lock *lk,
+                            const int locked)
 {
     lane_bodies lb;
     gather(wb, bodies, &lb);
@@ -304,6 +359,10 @@ LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body 
             lb.vb[d] += lb.mb * P;
             lb.wa[d] -= p->ia_n[d] * ni + p->ia_t[0][d] * t1 + p->ia_t[1][d] * t2;
             lb.wb[d] += p->ib_n[d] * ni + p->ib_t[0][d] * t1 + p->ib_t[1][d] * t2;
+        }
+        if (locked) {
+            KEEP_IN_PLANE(lb.va, lk->a);
+            KEEP_IN_PLANE(lb.vb, lk->b);
         }
     }
     scatter(wb, bodies, &lb);
@@ -336,7 +395,7 @@ LANE_INLINE void gather_motion(const wide_batch *wb, const step_context *ctx, la
 
 /* The normal rows of every point of a batch (contact_solve's first loop). */
 LANE_INLINE void solve_normal_rows(const wide_batch *wb, wide_point *pts, const step_context *ctx, lane_bodies *lb,
-                                   int use_bias, int hold_bounces)
+                                   int use_bias, int hold_bounces, const wide_lock *lk, const int locked)
 {
     lane_t dp[3], dqa[3], dqb[3];
     gather_motion(wb, ctx, dp, dqa, dqb);
@@ -384,11 +443,16 @@ LANE_INLINE void solve_normal_rows(const wide_batch *wb, wide_point *pts, const 
             lb->vb[d] += lbm * wb->n[d];
             lb->wb[d] += lambda * p->ib_n[d];
         }
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
     }
 }
 
 /* The friction rows of every point of a batch (contact_solve's second loop). */
-LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane_bodies *lb)
+LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane_bodies *lb, const wide_lock *lk,
+                                     const int locked)
 {
     for (int i = 0; i < wb->count; i++) {
         wide_point *p = &pts[i];
@@ -421,17 +485,21 @@ LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane
             lb->wa[d] -= p->ia_t[0][d] * d1 + p->ia_t[1][d] * d2;
             lb->wb[d] += p->ib_t[0][d] * d1 + p->ib_t[1][d] * d2;
         }
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
     }
 }
 
 /* The scalar contact_solve (contact_solver.c), four manifolds at a time. */
 LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_context *ctx, int use_bias,
-                             int hold_bounces)
+                             int hold_bounces, const wide_lock *lk, const int locked)
 {
     lane_bodies lb;
     gather(wb, ctx->bodies, &lb);
-    solve_normal_rows(wb, pts, ctx, &lb, use_bias, hold_bounces);
-    if (ctx->friction) solve_friction_rows(wb, pts, &lb);
+    solve_normal_rows(wb, pts, ctx, &lb, use_bias, hold_bounces, lk, locked);
+    if (ctx->friction) solve_friction_rows(wb, pts, &lb, lk, locked);
     scatter(wb, ctx->bodies, &lb);
 }
 
@@ -512,10 +580,9 @@ LANE_INLINE void gather_manifolds(const wide_batch *wb, contact_constraint *cc, 
  * inertias, and the effective masses as solver.c:
  * 1 / (1/mA + 1/mB + (IA^-1 (rA x n)).(rA x n) + ...) */
 LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wide_point *p, const lane_t ra[3],
-                              const lane_t rb[3])
+                              const lane_t rb[3], const lane_t lin[3])
 {
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
-    const lane_t mab = lm->ma + lm->mb;
     CROSS(p->ra_n, ra, wb->n);
     CROSS(p->rb_n, rb, wb->n);
     MAT_VEC(p->ia_n, lm->ia, p->ra_n);
@@ -528,9 +595,9 @@ LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wi
         MAT_VEC(p->ia_t[q], lm->ia, p->ra_t[q]);
         MAT_VEC(p->ib_t[q], lm->ib, p->rb_t[q]);
     }
-    lane_t kn = mab + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
-    lane_t k1 = mab + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
-    lane_t k2 = mab + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
+    lane_t kn = lin[0] + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
+    lane_t k1 = lin[1] + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
+    lane_t k2 = lin[2] + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
     lane_t ikn = one / SELECT_LANES(kn > zero, kn, one), ik1 = one / SELECT_LANES(k1 > zero, k1, one),
            ik2 = one / SELECT_LANES(k2 > zero, k2, one);
     p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
@@ -576,13 +643,26 @@ LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, i
     return deepest;
 }
 
+/* A plane-locked body's 1/m counts only the row's part in its plane
+ * (locked_inv_mass, constraint.h): (1/m)(1 - (d.l)^2) per lane. */
+#define LOCKED_INV_MASS(m, d, l) ((m) * (one - DOT3(d, l) * DOT3(d, l)))
+
 LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_constraint *cc,
-                                 const impulse_body *bodies, double warm)
+                                 const impulse_body *bodies, double warm, const wide_lock *lk)
 {
     static const manifold_point no_point = {{0, 0, 0}, 0, 0};
     static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm);
+    /* the linear share of each row's inverse effective mass (n, t1, t2) */
+    lane_t lin[3];
+    lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
+    if (lk) {
+        const lane_t one = SPLAT(1.0);
+        lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, lk->a) + LOCKED_INV_MASS(lm.mb, wb->n, lk->b);
+        lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t1, lk->b);
+        lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t2, lk->b);
+    }
     double deepest = 0.0;
     for (int i = 0; i < wb->count; i++) {
         wide_point *p = &pts[i];
@@ -600,7 +680,7 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
             ra[d] = point[d] - lm.center_a[d];
             rb[d] = point[d] - lm.center_b[d];
         }
-        prepare_rows(wb, &lm, p, ra, rb);
+        prepare_rows(wb, &lm, p, ra, rb, lin);
         p->base_separation = sep;
         /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
         lane_t wxa[3], wxb[3];
@@ -625,14 +705,33 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm);                \
+            const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
+            ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm, lk);            \
+        }                                                                                                \
+    }                                                                                                    \
+    /* the locked batches' copies out of line: the free batches' loops stay as without them */         \
+    TARGET __attribute__((noinline)) static void warm_locked##SUFFIX(const wide_set *ws, impulse_body *bodies, \
+                                                                    int first, int last)                 \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            warm_batch(wb, &ws->points[wb->first], bodies, &ws->locks[wb->lock], 1);                     \
         }                                                                                                \
     }                                                                                                    \
     TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies, int first, int last) \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            warm_batch(wb, &ws->points[wb->first], bodies);                                              \
+            warm_batch(wb, &ws->points[wb->first], bodies, NULL, 0);                                     \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void solve_locked##SUFFIX(const wide_set *ws, const step_context *ctx, \
+                                                                     int use_bias, int hold_bounces, int first, \
+                                                                     int last)                           \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces, &ws->locks[wb->lock], 1); \
         }                                                                                                \
     }                                                                                                    \
     TARGET static void solve_batches##SUFFIX(const wide_set *ws, const step_context *ctx, int use_bias,  \
@@ -640,10 +739,11 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces);                        \
+            solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces, NULL, 0);               \
         }                                                                                                \
     }                                                                                                    \
-    static const wide_passes passes##SUFFIX = {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX};
+    static const wide_passes passes##SUFFIX = {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX, \
+                                               warm_locked##SUFFIX, solve_locked##SUFFIX};
 
 WIDE_PASSES(_base, )
 #if WIDE_AVX2
@@ -673,6 +773,7 @@ typedef struct wide_job {
     const step_context *ctx;
     contact_constraint *cc;
     int offset, use_bias, hold_bounces;
+    int split;                   /* the colour's first locked batch */
 } wide_job;
 
 static void prepare_range(int begin, int end, int worker, void *p)
@@ -687,21 +788,26 @@ static void warm_range(int begin, int end, int worker, void *p)
 {
     const wide_job *j = p;
     (void)worker;
-    j->passes->warm(j->ws, j->ctx->bodies, j->offset + begin, j->offset + end);
+    /* a colour's locked batches (split on) come after its free ones */
+    int first = j->offset + begin, last = j->offset + end, mid = j->split < last ? j->split : last;
+    if (first < mid) j->passes->warm(j->ws, j->ctx->bodies, first, mid);
+    if (mid < last) j->passes->warm_locked(j->ws, j->ctx->bodies, mid > first ? mid : first, last);
 }
 
 static void solve_range(int begin, int end, int worker, void *p)
 {
     const wide_job *j = p;
     (void)worker;
-    j->passes->solve(j->ws, j->ctx, j->use_bias, j->hold_bounces, j->offset + begin, j->offset + end);
+    int first = j->offset + begin, last = j->offset + end, mid = j->split < last ? j->split : last;
+    if (first < mid) j->passes->solve(j->ws, j->ctx, j->use_bias, j->hold_bounces, first, mid);
+    if (mid < last) j->passes->solve_locked(j->ws, j->ctx, j->use_bias, j->hold_bounces, mid > first ? mid : first, last);
 }
 
 /* Prepare reads the bodies and writes only its own batches: every batch at
  * once. The deepest overlap is taken over the batches in order afterwards. */
 double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
 {
-    wide_job j = {ws, passes_for(ws), ctx, cc, 0, 0, 0};
+    wide_job j = {ws, passes_for(ws), ctx, cc, 0, 0, 0, 0};
     tasks_run(ctx->tasks, ws->batch_count, WIDE_MIN_RANGE, prepare_range, &j);
     double deepest = 0.0;
     for (int k = 0; k < ws->batch_count; k++) deepest = dmax(deepest, ws->deepest[k]);
@@ -713,18 +819,20 @@ double wide_prepare(const wide_set *ws, contact_constraint *cc, const step_conte
  * at once with the same result as one after another). */
 void wide_warm_start(const wide_set *ws, const step_context *ctx)
 {
-    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, 0, 0};
+    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, 0, 0, 0};
     for (int c = 0; c < WIDE_COLORS; c++) {
         j.offset = ws->color_first[c];
+        j.split = ws->color_locked[c];
         tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, warm_range, &j);
     }
 }
 
 void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces)
 {
-    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, use_bias, hold_bounces};
+    wide_job j = {ws, passes_for(ws), ctx, NULL, 0, use_bias, hold_bounces, 0};
     for (int c = 0; c < WIDE_COLORS; c++) {
         j.offset = ws->color_first[c];
+        j.split = ws->color_locked[c];
         tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, solve_range, &j);
     }
 }

@@ -10,8 +10,9 @@
 typedef struct wide_set wide_set;
 /* Colours the constraints and lays out the batches in *mem (grown as
  * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
- * and filling the batch headers; NULL on out of memory. */
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nb);
+ * and filling the batch headers; nlocked: how many constraints have a
+ * plane-locked body (they get batches of their own). NULL on out of memory. */
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb);
 /* The constraints left to the scalar passes, in order. */
 int wide_overflow(const wide_set *ws, const int **list);
 /* Prepares every batched manifold's points four lanes at a time, as

@@ -579,7 +579,7 @@ static void test_momentum_conserved_in_free_collisions(void **state)
  * (contact_solver.c), the wide ones point after point, so the sliding
  * boxes (4 points) are held to the analytic answer only: the two differ
  * by 1.9e-5 m of the 2.55 m slide; the 1-point manifolds to rounding. */
-enum { ROW_SLIDE, ROW_ROLL, ROW_BOUNCE };
+enum { ROW_SLIDE, ROW_ROLL, ROW_BOUNCE, ROW_SLIDE_LOCKED, ROW_TILT_LOCKED };
 
 static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
 {
@@ -592,10 +592,21 @@ static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
     for (int i = 0; i < n; i++) {
         carom_body_def d = carom_body_def_default();
         double x = 4.0 * (i % 12), y = 4.0 * (i / 12);
-        if (kind == ROW_SLIDE) {
+        if (kind == ROW_SLIDE || kind == ROW_SLIDE_LOCKED) {
             d.position = vec(x, y, 0.5);
             d.shape = carom_shape_box(0.5, 0.5, 0.5);
             d.friction = 0.5;
+            d.lock_to_plane = kind == ROW_SLIDE_LOCKED; /* the x-z plane */
+        } else if (kind == ROW_TILT_LOCKED) {
+            /* a sphere locked to a plane tilted 37 degrees about x: the
+             * ground's normal has a part along the lock, and the sphere may
+             * spin only about the lock's normal, so it slides */
+            d.position = vec(x, y, 0.25);
+            d.shape = carom_shape_sphere(0.25);
+            d.friction = 0.5;
+            d.lock_to_plane = 1;
+            d.plane_normal = vec(0, 0.6, 0.8);
+            d.linear_velocity = vec(5, 0, 0);
         } else {
             d.position = vec(x, y, kind == ROW_BOUNCE ? 1.1 : 0.25);
             d.shape = carom_shape_sphere(kind == ROW_BOUNCE ? 0.1 : 0.25);
@@ -606,11 +617,11 @@ static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
         ids[i] = carom_body_create(w, &d);
         assert_false(carom_body_id_is_null(ids[i]));
     }
-    if (kind == ROW_SLIDE) {
+    if (kind == ROW_SLIDE || kind == ROW_SLIDE_LOCKED) {
         step_n(w, 10, DT);
         for (int i = 0; i < n; i++) assert_int_equal(carom_body_set_linear_velocity(w, ids[i], vec(5, 0, 0)), CAROM_OK);
     }
-    int steps = kind == ROW_SLIDE ? 180 : kind == ROW_ROLL ? 120 : 40;
+    int steps = kind == ROW_ROLL || kind == ROW_TILT_LOCKED ? 120 : kind == ROW_BOUNCE ? 40 : 180;
     int most = 0;
     for (int s = 0; s < steps; s++) {
         step_n(w, 1, DT);
@@ -654,6 +665,45 @@ static void test_wide_passes_match_scalar(void **state)
             double apex = lone_p.z - 0.1 + lone_v.z * lone_v.z / (2 * G);
             EXPECT_NEAR(apex, 0.25, 0.02 * 0.25, "rebound apex");
         }
+    }
+}
+
+/* Plane-locked bodies in the wide passes (their manifolds in batches of
+ * their own, the lock kept per lane after every row). A row of boxes locked
+ * to the x-z plane slides from 5 m/s along x to the analytic stopping
+ * distance v^2 / (2 mu g), and never leaves its plane (the lone box, solved
+ * by the scalar passes' block, differs by the block's 1e-5 m). A
+ * row of spheres locked to a plane tilted about x (the ground pushes partly
+ * along the lock: the rows' effective masses take the reduced response,
+ * and friction pulls partly out of the plane) follows the lone sphere,
+ * solved by the scalar passes (1-point manifolds: the same rows), to
+ * rounding. */
+static void test_wide_locked_match_scalar(void **state)
+{
+    (void)state;
+    const int n = 96;
+    carom_vec3 ref_p[1] = {{0, 0, 0}}, ref_v[1] = {{0, 0, 0}}, row_p[96], row_v[96];
+    for (int kind = ROW_SLIDE_LOCKED; kind <= ROW_TILT_LOCKED; kind++) {
+        if (kind == ROW_TILT_LOCKED) run_row(kind, 1, ref_p, ref_v);
+        run_row(kind, n, row_p, row_v);
+        carom_vec3 nrm = kind == ROW_TILT_LOCKED ? vec(0, 0.6, 0.8) : vec(0, 1, 0);
+        double z0 = kind == ROW_TILT_LOCKED ? 0.25 : 0.5;
+        for (int i = 0; i < n; i++) {
+            double dp = fabs(row_p[i].x - ref_p[0].x) + fabs(row_p[i].y - ref_p[0].y) + fabs(row_p[i].z - ref_p[0].z);
+            double dv = fabs(row_v[i].x - ref_v[0].x) + fabs(row_v[i].y - ref_v[0].y) + fabs(row_v[i].z - ref_v[0].z);
+            if (kind == ROW_TILT_LOCKED && !(dp < 1e-9 && dv < 1e-9)) {
+                print_error("kind %d body %d: locked wide differs by %.3g m, %.3g m/s\n", kind, i, dp, dv);
+                fail();
+            }
+            double vn = row_v[i].x * nrm.x + row_v[i].y * nrm.y + row_v[i].z * nrm.z;
+            double pn = row_p[i].x * nrm.x + row_p[i].y * nrm.y + row_p[i].z * nrm.z;
+            assert_true(fabs(vn) <= 1e-12);
+            /* still in the plane through the start (0, y, z0), shifted to x = 0, y = 0 */
+            assert_true(fabs(pn - z0 * nrm.z) <= 1e-9);
+            if (kind == ROW_SLIDE_LOCKED)
+                EXPECT_NEAR(row_p[i].x, 25.0 / (2 * 0.5 * G), 0.03 * 25.0 / (2 * 0.5 * G), "locked stopping distance");
+        }
+        if (kind == ROW_TILT_LOCKED) assert_true(ref_p[0].x > 0.5); /* it moved along the plane */
     }
 }
 
@@ -1157,6 +1207,7 @@ int main(void)
         cmocka_unit_test(test_momentum_conserved_in_free_collisions),
         cmocka_unit_test(test_wide_passes_match_scalar),
         cmocka_unit_test(test_wide_kernels_agree),
+        cmocka_unit_test(test_wide_locked_match_scalar),
         cmocka_unit_test(test_mass_ratio_holds_in_a_wide_step),
         cmocka_unit_test(test_resting_sag_is_the_soft_deflection),
         cmocka_unit_test(test_cylinder_rolls_on_plane_and_box),
