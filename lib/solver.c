@@ -355,8 +355,10 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
     c->warm = cd->state;
     c->center_a = bs->center[sa];
     c->center_b = bs->center[sb];
-    /* plane normals (attach_extras): a moving body's, when it is locked to a plane */
-    c->locked = (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
+    /* plane normals (attach_extras): a moving body's, when it is locked to a plane
+     * (none where no awake body is: solver_memory.planar) */
+    c->locked = !w->scratch.solver.planar ? 0 :
+                (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
                 (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
     c->an = NULL;
     c->r = NULL;
