@@ -96,7 +96,7 @@ static void project_planar(const carom_world *w, const step_context *ctx)
 }
 
 /* Scales v back to length max (counting it); overflow-safe for huge finite v. */
-static vec3 clamp_length(vec3 v, double max, int *clamped)
+static inline __attribute__((always_inline)) vec3 clamp_length(vec3 v, double max, int *clamped)
 {
     double m = dmax(fabs(v.x), dmax(fabs(v.y), fabs(v.z)));
     if (!(m > max / 2)) return v; /* |v| <= sqrt(3) m, and NaN passes to the guard */
