@@ -179,13 +179,13 @@ static int still_apart(const contact *c, const xform *now, double spec)
 /* Records the pose a freshly computed manifold belongs to (see reuse_manifold,
  * still_apart). An empty one stores the separation of the two shapes along
  * its normal, a lower bound on their distance. now: B's frame in A's. */
-static void remember_pose(contact *c, contact_data *d, const shape *sa, xform xa, const shape *sb, xform xb, double spec,
-                          const xform *now)
+static void remember_pose(contact *c, contact_data *d, const manifold *m, const shape *sa, xform xa, const shape *sb,
+                          xform xb, double spec, const xform *now)
 {
     c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
-    if (d->m.count == 0) {
+    if (m->count == 0) {
         if (sa->type == SHAPE_PLANE || sb->type == SHAPE_PLANE) return; /* cheap anyway; no finite reach */
-        vec3 n = d->m.normal;
+        vec3 n = m->normal;
         vec3 top_a = xf_point(xa, shape_support_local(sa, q_inv_rotate(xa.q, n)));
         vec3 low_b = xf_point(xb, shape_support_local(sb, q_inv_rotate(xb.q, v3_neg(n))));
         double gap = v3_dot(n, v3_sub(low_b, top_a));
@@ -230,12 +230,12 @@ static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, do
             int best = -1;
             double best_dot = 0.9;
             for (int k = 0; k < COMPOSITE_MAX_MANIFOLDS; k++) {
-                if (taken[k] || index[k] < 0 || cs->data[index[k]].m.count == 0) continue;
-                double d = v3_dot(cs->data[index[k]].m.normal, found[j].normal);
+                if (taken[k] || index[k] < 0 || (CONTACT_DATA(cs, index[k]))->m.count == 0) continue;
+                double d = v3_dot((CONTACT_DATA(cs, index[k]))->m.normal, found[j].normal);
                 if (d > best_dot) { best_dot = d; best = k; }
             }
             for (int k = 0; best < 0 && k < COMPOSITE_MAX_MANIFOLDS; k++)
-                if (!taken[k] && (index[k] < 0 || cs->data[index[k]].m.count == 0)) best = k;
+                if (!taken[k] && (index[k] < 0 || (CONTACT_DATA(cs, index[k]))->m.count == 0)) best = k;
             if (best < 0) best = 0; /* cannot happen: at most COMPOSITE_MAX_MANIFOLDS per child pair */
             taken[best] = 1;
             sub_of[j] = base[j0] + (uint32_t)best;
@@ -252,8 +252,9 @@ static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, do
             if (k < 0) continue;
             if (sub + 1 > cs->items[ci].sub_limit) cs->items[ci].sub_limit = sub + 1;
         }
+        if (!contact_data_alloc(cs, k)) continue; /* out of memory: the manifold is dropped */
         contact *c = &cs->items[k];
-        contact_data *d = &cs->data[k];
+        contact_data *d = CONTACT_DATA(cs, k);
         material_mix_contact(w, k);
         manifold old_m = d->m;
         contact_point_state old_state[MANIFOLD_MAX_POINTS];
@@ -273,7 +274,7 @@ static int collide_composite_pair(carom_world *w, int ci, xform xa, xform xb, do
         int k = sub == 0 ? ci : contact_find_sub(cs, id_a, id_b, sub);
         if (k < 0) continue;
         contact *c = &cs->items[k];
-        cs->data[k].m.count = 0;
+        if (c->slot) CONTACT_DATA(cs, k)->m.count = 0;
         int was = (c->flags & CONTACT_TOUCHING) != 0;
         c->flags = (c->flags & ~(uint32_t)(CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_REUSABLE | CONTACT_APART)) |
                    (was ? CONTACT_WAS_TOUCHING : 0) | CONTACT_SIM;
@@ -332,15 +333,17 @@ COLLIDE_INLINE double pair_look_ahead(const carom_world *w, const step_context *
  * its manifold refreshed, kept, or known empty; returns 1 when it has
  * points. a, b: the bodies' slots, awake_a, awake_b: body_awake of each.
  * Reads and writes contact i alone (and reads the bodies), so pairs run in
- * any order and at once. */
+ * any order and at once, except that a pair without a data slot that finds
+ * points takes one from the pool: only when may_add; else (run in parallel)
+ * it returns -1 with the contact as it was, for the ordered pass to redo. */
 COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i, int a, int b, int awake_a, int awake_b,
-                                  double reuse)
+                                  double reuse, int may_add)
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
     contact *c = &cs->items[i];
-    contact_data *d = &cs->data[i];
+    contact_data *d = CONTACT_DATA(cs, i);
     double spec = pair_look_ahead(w, ctx, a, b);
     /* bounds farther apart than the look-ahead: no point can be within it
      * (the gap between boxes bounds the distance), so skip the narrowphase */
@@ -355,8 +358,28 @@ COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i
     xform now = relative_pose(xa, xb);
     if (reuse_manifold(c, d, xa, &now, reuse)) return 1; /* kept: ids, impulses and feature cache stay as they were */
     if (still_apart(c, &now, spec)) return 0;
-    if (d->m.count == 0) {
-        /* most pairs near contact: nothing to carry over, nothing to copy */
+    const manifold *m = &d->m;
+    manifold found;
+    if (!c->slot) {
+        /* most pairs near contact: no data yet, and most find none */
+        manifold none;
+        none.count = 0;
+        collide_cache kept;
+        if (!may_add) kept = c->cache; /* (may_add is a constant where this is inlined) */
+        collide(&s->shapes[a], *xa, &s->shapes[b], *xb, spec, &c->cache, &found);
+        m = &found;
+        if (found.count > 0) {
+            if (!may_add) { c->cache = kept; return -1; }
+            if (!contact_data_alloc(cs, i)) return 0; /* out of memory: no manifold, tried again next step */
+            c = &cs->items[i];
+            d = CONTACT_DATA(cs, i);
+            material_mix_contact(w, i);
+            d->m = found;
+            m = &d->m;
+            contact_match_points(d, &none, d->state, *xa);
+        }
+    } else if (d->m.count == 0) {
+        /* nothing to carry over, nothing to copy */
         manifold none;
         none.count = 0;
         collide(&s->shapes[a], *xa, &s->shapes[b], *xb, spec, &c->cache, &d->m);
@@ -368,8 +391,8 @@ COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i
         collide(&s->shapes[a], *xa, &s->shapes[b], *xb, spec, &c->cache, &d->m);
         if (d->m.count > 0) contact_match_points(d, &old_m, old_state, *xa);
     }
-    remember_pose(c, d, &s->shapes[a], *xa, &s->shapes[b], *xb, spec, &now);
-    return d->m.count > 0;
+    remember_pose(c, d, m, &s->shapes[a], *xa, &s->shapes[b], *xb, spec, &now);
+    return m->count > 0;
 }
 
 /* Refreshes the manifold(s) of contact i (a pair's own contact, sub 0, with
@@ -385,7 +408,7 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
     contact_set *cs = &w->contacts;
     step_scratch *sc = &w->scratch;
     contact *c = &cs->items[i];
-    contact_data *d = &cs->data[i];
+    contact_data *d = CONTACT_DATA(cs, i);
     int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
     int bounds_overlap = aabb_overlap(s->fat_box[a], s->fat_box[b]);
     if (!bounds_overlap && may_remove) {
@@ -402,7 +425,7 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
         int near = bounds_overlap && aabb_overlap(aabb_fatten(ba, spec), bb);
         touching = collide_composite_pair(w, i, xa, xb, spec, near);
         c = &cs->items[i]; /* extra contacts may have moved the arrays */
-        d = &cs->data[i];
+        d = CONTACT_DATA(cs, i);
         int was = (c->flags & CONTACT_ANY_TOUCHING) != 0;
         c->flags = (c->flags & ~(uint32_t)CONTACT_ANY_TOUCHING) | (touching ? CONTACT_ANY_TOUCHING : 0);
         if (touching && (!awake_a || !awake_b)) {
@@ -412,9 +435,9 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
         if (touching != was) {
             /* the event speaks of the pair: any manifold with points */
             int ei = i;
-            for (uint32_t k = 1; cs->data[ei].m.count == 0 && k < c->sub_limit; k++) {
+            for (uint32_t k = 1; (CONTACT_DATA(cs, ei))->m.count == 0 && k < c->sub_limit; k++) {
                 int e = contact_find_sub(cs, c->id_a, c->id_b, k);
-                if (e >= 0 && cs->data[e].m.count > 0) ei = e;
+                if (e >= 0 && (CONTACT_DATA(cs, e))->m.count > 0) ei = e;
             }
             events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
         }
@@ -425,7 +448,7 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
         touching = (c->flags & CONTACT_PRECOMPUTED_TOUCHING) != 0; /* precompute_range did the work */
         c->flags &= ~(uint32_t)(CONTACT_PRECOMPUTED | CONTACT_PRECOMPUTED_TOUCHING);
     } else if (bounds_overlap) {
-        touching = narrow_contact(w, ctx, i, a, b, awake_a, awake_b, reuse);
+        touching = narrow_contact(w, ctx, i, a, b, awake_a, awake_b, reuse, 1);
     } else if (c->flags & CONTACT_TOUCHING) { /* else the manifold is already empty */
         d->m.count = 0;
     }
@@ -440,6 +463,7 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
     if (touching && !was) events_touch(w, i, CAROM_EVENT_BEGIN);
     else if (!touching && was) events_touch(w, i, CAROM_EVENT_END);
     if (touching) list_touching(sc, s, i, a, b);
+    else if (c->slot && contact_data_idle(cs, i)) contact_data_release(cs, i); /* nothing left to keep */
     return 1;
 }
 
@@ -474,7 +498,8 @@ static void precompute_range(int begin, int end, int worker, void *p)
             continue;
         if (shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b])) continue;
         if (!aabb_overlap(s->fat_box[a], s->fat_box[b]) || !filter_bits_allow(s, a, b)) continue;
-        int touching = narrow_contact(w, j->ctx, i, a, b, awake_a, awake_b, j->reuse);
+        int touching = narrow_contact(w, j->ctx, i, a, b, awake_a, awake_b, j->reuse, 0);
+        if (touching < 0) continue; /* needs a data slot: the ordered pass computes it */
         c->flags |= CONTACT_PRECOMPUTED | (touching ? CONTACT_PRECOMPUTED_TOUCHING : 0u);
     }
 }

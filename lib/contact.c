@@ -94,13 +94,56 @@ static void map_remove(pair_map *m, uint64_t key, uint32_t sub)
 int contact_set_init(contact_set *cs)
 {
     memset(cs, 0, sizeof *cs);
+    if (!array_reserve((void **)&cs->data, &cs->data_capacity, 1, sizeof *cs->data)) return 0;
+    memset(&cs->data[0], 0, sizeof cs->data[0]);
+    cs->data_count = 1;
     return map_init(&cs->map, 64);
+}
+
+int contact_data_alloc(contact_set *cs, int i)
+{
+    if (cs->items[i].slot) return 1;
+    int slot;
+    if (cs->free_count > 0) {
+        slot = cs->data_free[--cs->free_count];
+    } else {
+        if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->data_count + 1, sizeof *cs->data)) return 0;
+        slot = cs->data_count++;
+    }
+    memset(&cs->data[slot], 0, sizeof cs->data[slot]);
+    cs->items[i].slot = slot;
+    return 1;
+}
+
+void contact_data_release(contact_set *cs, int i)
+{
+    int slot = cs->items[i].slot;
+    if (!slot) return;
+    cs->items[i].slot = 0;
+    if (slot == cs->data_count - 1) { cs->data_count--; return; }
+    /* room for every slot was reserved when the slot was made (below): cannot fail */
+    cs->data_free[cs->free_count++] = slot;
+}
+
+static int bits_zero(vec3 v)
+{
+    static const vec3 zero = {0, 0, 0};
+    return memcmp(&v, &zero, sizeof v) == 0;
+}
+
+int contact_data_idle(const contact_set *cs, int i)
+{
+    const contact *c = &cs->items[i];
+    const contact_data *d = &cs->data[c->slot];
+    return !(c->flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING | CONTACT_REUSABLE)) &&
+           d->m.count == 0 && bits_zero(d->tangent1);
 }
 
 void contact_set_free(contact_set *cs)
 {
     free(cs->items);
     free(cs->data);
+    free(cs->data_free);
     free(cs->map.keys);
     free(cs->map.subs);
     free(cs->map.values);
@@ -120,18 +163,27 @@ int contact_add(contact_set *cs, int a, int b) { return contact_add_sub(cs, a, b
 
 int contact_set_reserve(contact_set *cs, int n)
 {
+    /* (data slots for all, at most: pages never written cost nothing; contact_set_trim) */
     return array_reserve((void **)&cs->items, &cs->capacity, n, sizeof *cs->items) &&
-           array_reserve((void **)&cs->data, &cs->data_capacity, n, sizeof *cs->data);
+           array_reserve((void **)&cs->data, &cs->data_capacity, n + 1, sizeof *cs->data);
+}
+
+void contact_set_trim(contact_set *cs)
+{
+    if (cs->data_capacity <= cs->data_count) return;
+    contact_data *d = realloc(cs->data, sizeof *cs->data * (size_t)cs->data_count);
+    if (!d) return; /* keeps the larger block */
+    cs->data = d;
+    cs->data_capacity = cs->data_count;
 }
 
 int contact_append(contact_set *cs, int a, int b, uint32_t sub)
 {
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
-    if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->count + 1, sizeof *cs->data)) return -1;
+    if (!array_reserve((void **)&cs->data_free, &cs->free_capacity, cs->count + 1, sizeof *cs->data_free)) return -1;
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);
-    memset(&cs->data[i], 0, sizeof cs->data[i]);
     c->id_a = a < b ? a : b;
     c->id_b = a < b ? b : a;
     c->cache.feature = -1;
@@ -195,11 +247,10 @@ int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
-    if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->count + 1, sizeof *cs->data)) return -1;
+    if (!array_reserve((void **)&cs->data_free, &cs->free_capacity, cs->count + 1, sizeof *cs->data_free)) return -1;
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);
-    memset(&cs->data[i], 0, sizeof cs->data[i]);
     c->id_a = a < b ? a : b;
     c->id_b = a < b ? b : a;
     c->cache.feature = -1;
@@ -212,10 +263,10 @@ void contact_remove(contact_set *cs, int i)
 {
     contact *c = &cs->items[i];
     map_remove(&cs->map, pair_key(c->id_a, c->id_b), c->sub);
+    contact_data_release(cs, i);
     int last = cs->count - 1;
     if (i != last) {
-        cs->items[i] = cs->items[last];
-        cs->data[i] = cs->data[last];
+        cs->items[i] = cs->items[last]; /* (its data stays in its slot) */
         map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), cs->items[i].sub, i);
     }
     cs->count--;

@@ -36,13 +36,16 @@ typedef struct contact {
     uint32_t sub;               /* 0: the broadphase pair's contact; k > 0: its k-th extra
                                    manifold (a mesh or height field gives one per normal) */
     uint32_t sub_limit;         /* sub 0 of a composite pair: every extra contact's sub is below this */
+    int slot;                   /* its contact_data in the pool; 0: none yet (the shared empty
+                                   record: a pair without a manifold reads zeros, never writes) */
     collide_cache cache;
     xform rel_pose;             /* B's frame in A's when the manifold was computed */
     double gap, reach_b;        /* apart: a lower bound on the distance then, and B's
                                    bounding radius (how far B's surface reaches) */
 } contact;
 
-/* The manifold and warm-start state of a pair, at the same index. */
+/* The manifold and warm-start state of a pair, in the pool at its slot:
+ * only pairs that have (or recently had) a manifold hold one. */
 typedef struct contact_data {
     double friction, restitution; /* mixed from the two bodies' materials */
     double rolling_resistance;  /* mixed likewise (material.c) */
@@ -63,10 +66,25 @@ typedef struct pair_map {
 
 typedef struct contact_set {
     contact *items;
-    contact_data *data;         /* parallel to items */
-    int count, capacity, data_capacity;
+    contact_data *data;         /* the pool: data[0] stays all zeros (a slotless pair reads it) */
+    int count, capacity, data_count, data_capacity;
+    int *data_free;             /* slots given back, reused last in first out */
+    int free_count, free_capacity;
     pair_map map;
 } contact_set;
+
+/* Contact i's data (the empty record when it holds none: read only). */
+#define CONTACT_DATA(cs, i) (&(cs)->data[(cs)->items[(i)].slot])
+/* Gives contact i a zeroed data slot when it has none; 0 on out of memory.
+ * Moves the pool: pointers into it are stale after. */
+int contact_data_alloc(contact_set *cs, int i);
+/* Gives contact i's slot back (it reads the empty record after). */
+void contact_data_release(contact_set *cs, int i);
+/* Whether contact i's data holds nothing a zeroed record with the pair's
+ * mixed material would not: no points, no kept friction basis, and no flag
+ * under which its normal or A-frame normal is read. The material is left to
+ * the caller (it is the bodies' mix everywhere but in a restored snapshot). */
+int contact_data_idle(const contact_set *cs, int i);
 
 int contact_set_init(contact_set *cs);
 void contact_set_free(contact_set *cs);
@@ -77,6 +95,8 @@ int contact_add(contact_set *cs, int a, int b);
 /* Room for n contacts without growing the arrays (restoring a snapshot: the
  * map is built by contact_set_index). 0 on out of memory. */
 int contact_set_reserve(contact_set *cs, int n);
+/* Gives back the pool's room beyond the slots in use (after restoring). */
+void contact_set_trim(contact_set *cs);
 /* The same for a pair's extra manifold number sub (> 0). */
 int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub);
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub);

@@ -33,7 +33,7 @@ static void event_pair(carom_world *w, const contact *c, carom_contact_event *e,
 int events_touch(carom_world *w, int contact_index, carom_event_type type)
 {
     const contact *c = &w->contacts.items[contact_index];
-    const contact_data *d = &w->contacts.data[contact_index];
+    const contact_data *d = CONTACT_DATA(&w->contacts, contact_index);
     carom_contact_event e;
     event_pair(w, c, &e, type);
     e.normal.x = d->m.normal.x; e.normal.y = d->m.normal.y; e.normal.z = d->m.normal.z;
@@ -48,7 +48,7 @@ int events_hit(carom_world *w, int contact_index, int point, double normal_impul
                double approach_speed, double dt)
 {
     const contact *c = &w->contacts.items[contact_index];
-    const contact_data *d = &w->contacts.data[contact_index];
+    const contact_data *d = CONTACT_DATA(&w->contacts, contact_index);
     carom_contact_event e;
     event_pair(w, c, &e, CAROM_EVENT_HIT);
     vec3 pt = d->m.points[point].point;
@@ -64,7 +64,7 @@ int events_hit(carom_world *w, int contact_index, int point, double normal_impul
 int events_force(carom_world *w, int contact_index, double normal_impulse, double force, vec3 point)
 {
     const contact *c = &w->contacts.items[contact_index];
-    const contact_data *d = &w->contacts.data[contact_index];
+    const contact_data *d = CONTACT_DATA(&w->contacts, contact_index);
     carom_contact_event e;
     event_pair(w, c, &e, CAROM_EVENT_FORCE);
     e.point.x = point.x; e.point.y = point.y; e.point.z = point.z;

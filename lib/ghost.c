@@ -124,7 +124,7 @@ static double reach_along(const shape *s, xform x, vec3 n, aabb near)
  * must be recomputed. */
 static void unsolved(contact_set *cs, int ci)
 {
-    contact_data *d = &cs->data[ci];
+    contact_data *d = CONTACT_DATA(cs, ci);
     for (int k = 0; k < MANIFOLD_MAX_POINTS; k++) {
         d->state[k].normal_impulse = 0;
         d->state[k].tangent_impulse[0] = d->state[k].tangent_impulse[1] = 0;
@@ -170,7 +170,7 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
         while (last < n && e[last].dynamic == e[first].dynamic) last++;
         for (int i = first; i < last && last - first > 1; i++) {
             if (e[i].listed < 0 || s->type[s->ids[e[i].other].slot] != CAROM_BODY_STATIC) continue;
-            contact_data *di = &cs->data[e[i].contact];
+            contact_data *di = CONTACT_DATA(cs, e[i].contact);
             if (di->m.count == 0) continue;
             double hi = surface_offset(&di->m, e[i].normal);
             manifold_point pts[MERGE_MAX];
@@ -181,7 +181,7 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
             for (int j = i + 1; j < last; j++) {
                 if (e[j].listed < 0 || e[j].other == e[i].other) continue;
                 if (s->type[s->ids[e[j].other].slot] != CAROM_BODY_STATIC) continue;
-                contact_data *dj = &cs->data[e[j].contact];
+                contact_data *dj = CONTACT_DATA(cs, e[j].contact);
                 if (dj->m.count == 0 || np + dj->m.count > MERGE_MAX) continue;
                 if (v3_dot(e[i].normal, e[j].normal) < MERGE_COS) continue;
                 if (dj->friction != di->friction || dj->restitution != di->restitution) continue;
@@ -236,7 +236,7 @@ static int merge_coplanar(carom_world *w, ghost_entry *e, int n, double tol)
              * started from zero every step, and at one iteration (fast) the
              * box rocked at 1.3 mm/s vertical) */
             for (int g = 0; g < merged; g++) {
-                contact_data *dj = &cs->data[e[group[g]].contact];
+                contact_data *dj = CONTACT_DATA(cs, e[group[g]].contact);
                 vec3 nj = dj->m.normal;
                 dj->m = di->m;
                 dj->m.normal = v3_dot(nj, mn) < 0 ? v3_neg(mn) : mn;
@@ -262,8 +262,8 @@ void world_share_merged_impulses(carom_world *w, const step_context *ctx)
     step_scratch *sc = &w->scratch;
     for (int k = 0; k < sc->merged_count; k++) {
         int lead = sc->merged[2 * k], follower = sc->merged[2 * k + 1];
-        const contact_data *dl = &cs->data[lead];
-        contact_data *df = &cs->data[follower];
+        const contact_data *dl = CONTACT_DATA(cs, lead);
+        contact_data *df = CONTACT_DATA(cs, follower);
         const contact *cf = &cs->items[follower];
         if (df->m.count != dl->m.count) continue;
         /* the same order of bodies (the normal's sign): the friction basis
@@ -309,7 +309,7 @@ void world_remove_ghost_contacts(carom_world *w, const step_context *ctx)
         const contact *c = &cs->items[ci];
         int da = s->type[s->ids[c->id_a].slot] == CAROM_BODY_DYNAMIC;
         /* the manifold's normal points from a to b */
-        vec3 normal = da ? v3_neg(cs->data[ci].m.normal) : cs->data[ci].m.normal;
+        vec3 normal = da ? v3_neg((CONTACT_DATA(cs, ci))->m.normal) : (CONTACT_DATA(cs, ci))->m.normal;
         ghost_entry g = {da ? c->id_a : c->id_b, da ? c->id_b : c->id_a, ci, k, normal};
         e[n++] = g;
     }

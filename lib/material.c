@@ -98,7 +98,8 @@ void material_mix_contact(carom_world *w, int contact_index)
 {
     const body_store *s = &w->bodies;
     const contact *c = &w->contacts.items[contact_index];
-    contact_data *d = &w->contacts.data[contact_index];
+    if (!c->slot) return; /* mixed when it takes a slot (collision.c) */
+    contact_data *d = CONTACT_DATA(&w->contacts, contact_index);
     double m[3];
     material_mix(s, s->ids[c->id_a].slot, s->ids[c->id_b].slot, c->sub, m);
     d->friction = m[0];

@@ -61,7 +61,7 @@ void world_pre_solve(carom_world *w, const step_context *ctx)
     for (int k = 0; k < sc->touching_count; k++) {
         int i = sc->touching[k];
         contact *c = &cs->items[i];
-        contact_data *d = &cs->data[i];
+        contact_data *d = CONTACT_DATA(cs, i);
         carom_manifold m = public_manifold(&d->m);
         if (w->pre_solve(w->pre_solve_context, world_make_id(w, c->id_a), world_make_id(w, c->id_b), &m)) {
             sc->touching[kept++] = i;
@@ -177,7 +177,7 @@ CAROM_API int carom_body_get_contacts(const carom_world *w, carom_body_id id, ca
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         if ((c->id_a != me && c->id_b != me) || !(c->flags & CONTACT_TOUCHING)) continue;
-        const contact_data *d = &cs->data[i];
+        const contact_data *d = CONTACT_DATA(cs, i);
         if (count < capacity) {
             carom_contact_info *ci = &out[count];
             int flip = c->id_b == me;

@@ -1170,9 +1170,9 @@ static unsigned contact_bits(const contact *c, const contact_data *d, const cont
                         (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
                         (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
                         (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
-                        (f64_bits(d->friction) == f64_bits(g.material[0]) && f64_bits(d->restitution) == f64_bits(g.material[1]) &&
-                                    f64_bits(d->rolling_resistance) == f64_bits(g.material[2])
-                             ? 0 : CREC_MATERIAL) |
+                        (!c->slot || (f64_bits(d->friction) == f64_bits(g.material[0]) && f64_bits(d->restitution) == f64_bits(g.material[1]) &&
+                                    f64_bits(d->rolling_resistance) == f64_bits(g.material[2]))
+                             ? 0 : CREC_MATERIAL) | /* (a pair without data has the bodies' mix) */
                         (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
                              ? CREC_POSE : 0) |
                         ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
@@ -1191,7 +1191,7 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
     int last_a = 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
-        const contact_data *d = &cs->data[i];
+        const contact_data *d = CONTACT_DATA(cs, i);
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
         contact_guess g = guess_contact(s, memo, s->collided, a, b, c->sub);
         /* what the reader will hold, and predict from */
@@ -1760,6 +1760,7 @@ static int read_contacts(reader *r, carom_world *w, const int *class_of)
     if (!ok) return 0;
     int repeated;
     if (!contact_set_index(cs, &repeated)) return bad(r, "out of memory");
+    contact_set_trim(cs);
     if (repeated >= 0) {
         const contact *c = &cs->items[repeated];
         return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", repeated, c->id_a, c->id_b, (unsigned)c->sub);
@@ -1792,9 +1793,9 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
         int ci = contact_append(cs, a, b, sub); /* (the pair map is built after the last, contact_set_index) */
-        if (ci < 0) return bad(r, "out of memory");
+        if (ci < 0 || !contact_data_alloc(cs, ci)) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
-        contact_data *d = &cs->data[ci];
+        contact_data *d = CONTACT_DATA(cs, ci);
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
         if (sub) { /* the compound children a manifold number names must exist (its material is theirs); sub 0 names child 0 */
             int child_a, child_b;
@@ -1883,6 +1884,11 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         /* one encoding per state: points all as predicted say so in the bits */
         if (!r->failed && d->m.count > 0 && !(bits & CREC_EXACT) && !inexact)
             return bad(r, "contact %d: its points are all as predicted but written", i);
+        /* nothing a slotless pair would not read (collision.c): the slot goes
+         * back, for the next contact */
+        if (!r->failed && contact_data_idle(cs, ci) && f64_bits(d->friction) == f64_bits(g.material[0]) &&
+            f64_bits(d->restitution) == f64_bits(g.material[1]) && f64_bits(d->rolling_resistance) == f64_bits(g.material[2]))
+            contact_data_release(cs, ci);
     }
     return !r->failed;
 }

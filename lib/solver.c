@@ -331,7 +331,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
 {
     const body_store *bs = &w->bodies;
     contact *ct = &w->contacts.items[i];
-    contact_data *cd = &w->contacts.data[i];
+    contact_data *cd = CONTACT_DATA(&w->contacts, i);
     const impulse_body *bodies = ctx->bodies;
     int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
     c->a = bs->solver_index[sa];
@@ -526,7 +526,7 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     v3_basis(up, &e1, &e2);
     int sorted = 1, nan = 0;
     for (int k = 0; k < n; k++) {
-        const manifold *m = &w->contacts.data[s->touching[k]].m;
+        const manifold *m = &CONTACT_DATA(&w->contacts, s->touching[k])->m;
         vec3 c = v3_zero();
         for (int j = 0; j < m->count; j++) c = v3_add(c, m->points[j].point);
         c = v3_scale(c, 1.0 / m->count);
@@ -585,7 +585,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     const contact_set *cs = &w->contacts;
     if (!sort_touching(w, ctx)) return 0;
     int ncon = s->touching_count, npoints = 0, nb = ctx->body_count;
-    for (int c = 0; c < ncon; c++) npoints += cs->data[s->touching[c]].m.count;
+    for (int c = 0; c < ncon; c++) npoints += (CONTACT_DATA(cs, s->touching[c]))->m.count;
     /* one block: constraints, then their points packed (most pairs of round
      * shapes have one point, so a fixed 4 per constraint would waste cache) */
     size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
@@ -603,7 +603,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     work->in_contact = work->level_count + nb + 3;
     for (int k = 0; k < ncon; k++) {
         cc[k].p = point_pool;
-        point_pool += cs->data[s->touching[k]].m.count;
+        point_pool += (CONTACT_DATA(cs, s->touching[k]))->m.count;
     }
     constraint_job job = {w, ctx, cc, NULL};
     tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
@@ -889,7 +889,7 @@ static void store_impulses_range(int begin, int end, int worker, void *p)
     (void)worker;
     for (int c = begin; c < end; c++) {
         const contact_constraint *con = &job->cc[c];
-        contact_data *cd = &job->w->contacts.data[con->contact];
+        contact_data *cd = CONTACT_DATA(&job->w->contacts, con->contact);
         for (int j = 0; j < con->count; j++) {
             const constraint_point *p = &con->p[j];
             cd->state[j].normal_impulse = p->normal_impulse;

@@ -61,7 +61,7 @@ static void test_combine_modes(void **state)
             assert_false(carom_body_id_is_null(a) || carom_body_id_is_null(b));
             step_n(w, 1, DT);
             assert_int_equal(w->contacts.count, 1);
-            const contact_data *cd = &w->contacts.data[0];
+            const contact_data *cd = CONTACT_DATA(&w->contacts, 0);
             carom_combine_mode mode = (carom_combine_mode)(ma > mb ? ma : mb);
             assert_true(fabs(cd->friction - combined(mode, 0, 0.8, 0.2)) < 1e-15);
             assert_true(fabs(cd->restitution - combined(mode, 1, 0.3, 0.6)) < 1e-15);
@@ -99,7 +99,7 @@ static void test_child_material(void **state)
     step_n(w, 2, DT);
     int seen = 0;
     for (int k = 0; k < w->contacts.count; k++) {
-        const contact_data *cd = &w->contacts.data[k];
+        const contact_data *cd = CONTACT_DATA(&w->contacts, k);
         if (cd->m.count == 0) continue;
         double x = cd->m.points[0].point.x;
         double want = x > 0 ? 0.02 : sqrt(0.5 * 0.6);
