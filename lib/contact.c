@@ -246,16 +246,8 @@ int contact_set_index(contact_set *cs, int *repeated)
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
-    if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
-    if (!array_reserve((void **)&cs->data_free, &cs->free_capacity, cs->count + 1, sizeof *cs->data_free)) return -1;
-    int i = cs->count++;
-    contact *c = &cs->items[i];
-    memset(c, 0, sizeof *c);
-    c->id_a = a < b ? a : b;
-    c->id_b = a < b ? b : a;
-    c->cache.feature = -1;
-    c->sub = sub;
-    map_put(&cs->map, pair_key(a, b), sub, i);
+    int i = contact_append(cs, a, b, sub);
+    if (i >= 0) map_put(&cs->map, pair_key(a, b), sub, i);
     return i;
 }
 
