@@ -21,6 +21,8 @@ typedef struct solver_memory {
     size_t wide_capacity;
     void *order;                 /* the manifolds' solve-order keys (sort_touching) */
     int order_capacity;
+    int *points;                 /* this step: each touching manifold's point count, in solve order */
+    int points_capacity;
     /* sort_touching's hint: last step's solve order (contact indices) and a
      * zeroed per-contact mark; only the work of the sort depends on them */
     int *last_order, *mark;
