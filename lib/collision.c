@@ -604,3 +604,82 @@ int world_collide(carom_world *w, const step_context *ctx)
     }
     return 1;
 }
+
+/* ---- falling asleep: a cache the bodies' own state reproduces ----------------------- */
+
+void world_settle_body(carom_world *w, int slot)
+{
+    body_store *s = &w->bodies;
+    /* the pose its pairs are settled at (world_settle_contacts) */
+    s->collided[slot] = body_xform(s, slot);
+    /* bounds fattened about where it rests, as a body at rest's are
+     * (world_body_fat_aabb): the last move's bounds were about an older pose */
+    aabb fat = world_body_fat_aabb(w, slot, WORLD_AABB_MARGIN);
+    if (memcmp(&fat, &s->fat_box[slot], sizeof fat) != 0) {
+        s->fat_box[slot] = fat;
+        bp_move_proxy(w->bp, s->proxy[slot], fat);
+    }
+}
+
+/* Contact i, both of whose bodies are now asleep or static. What the cache
+ * held from the poses of earlier narrowphase tests goes: the reuse pose (the
+ * first test after waking runs the narrowphase afresh), the apart bound, the
+ * last normal of a pair that no longer touches, the kept friction basis (the
+ * tangent impulses re-expressed in the basis the solver builds from the
+ * normal, contact_rest_basis: the same impulse). The manifold's points stay,
+ * held in A's frame at its collided pose with the world points made from
+ * them, so both follow from the bodies and the points in A's frame. */
+static void settle_contact(carom_world *w, int i)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    contact *c = &cs->items[i];
+    c->flags &= ~(uint32_t)(CONTACT_REUSABLE | CONTACT_APART);
+    const contact_data *d0 = CONTACT_DATA(cs, i);
+    int normal_read = d0->m.count > 0 || (c->flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING));
+    if (!normal_read) {
+        c->cache.has_normal = 0;
+        c->cache.normal = v3(0, 0, 0);
+    } else if (c->cache.has_normal) {
+        c->cache.normal = d0->m.normal;
+    }
+    if (!c->slot) return;
+    contact_data *d = CONTACT_DATA(cs, i);
+    xform xa = s->collided[s->ids[c->id_a].slot];
+    for (int k = 0; k < d->m.count; k++) {
+        manifold_point *p = &d->m.points[k];
+        contact_point_state *st = &d->state[k];
+        st->local_a = xf_inv_point(xa, p->point);
+        p->point = xf_point(xa, st->local_a);
+        st->separation = p->separation;
+    }
+    if (d->m.count == 0) {
+        d->tangent1 = v3(0, 0, 0);
+    } else if (c->cache.has_normal && (d->tangent1.x != 0 || d->tangent1.y != 0 || d->tangent1.z != 0)) {
+        vec3 n = d->m.normal, t1 = d->tangent1, t2 = v3_cross(n, t1);
+        vec3 u1 = contact_rest_basis(n), u2 = v3_cross(n, u1);
+        for (int k = 0; k < d->m.count; k++) {
+            contact_point_state *st = &d->state[k];
+            vec3 j = v3_add(v3_scale(t1, st->tangent_impulse[0]), v3_scale(t2, st->tangent_impulse[1]));
+            st->tangent_impulse[0] = v3_dot(j, u1);
+            st->tangent_impulse[1] = v3_dot(j, u2);
+        }
+        d->tangent1 = u1;
+    }
+    if (!(c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) && contact_data_idle(cs, i)) contact_data_release(cs, i);
+}
+
+void world_settle_contacts(carom_world *w)
+{
+    body_store *s = &w->bodies;
+    contact_set *cs = &w->contacts;
+    for (int i = 0; i < cs->count; i++) {
+        const contact *c = &cs->items[i];
+        int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
+        if (body_awake(s, a) || body_awake(s, b)) continue;
+        /* only pairs this step tested (an extra manifold: its pair's contact says) */
+        int primary = c->sub ? contact_find(cs, c->id_a, c->id_b) : i;
+        if (primary < 0 || !(cs->items[primary].flags & CONTACT_SIM)) continue;
+        settle_contact(w, i);
+    }
+}

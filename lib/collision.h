@@ -11,4 +11,13 @@ int world_update_pairs(carom_world *w, const step_context *ctx);
  * begin/end events; 0 on out of memory. */
 int world_collide(carom_world *w, const step_context *ctx);
 
+/* An island fell asleep this step (island.c): world_settle_body for each of
+ * its bodies (the pose its pairs are held at, its bounds refitted about it),
+ * then world_settle_contacts once, which rewrites every contact this step
+ * tested whose bodies are all asleep or static so that what it keeps follows
+ * from the bodies' state (docs/snapshot.md: a snapshot then need not carry
+ * poses of older steps). The first test after waking runs the narrowphase. */
+void world_settle_body(carom_world *w, int slot);
+void world_settle_contacts(carom_world *w);
+
 #endif

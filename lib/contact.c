@@ -264,6 +264,14 @@ void contact_remove(contact_set *cs, int i)
     cs->count--;
 }
 
+vec3 contact_rest_basis(vec3 n)
+{
+    if (n.x == 0 && n.y == 0 && n.z == 0) return n;
+    vec3 t1, t2;
+    v3_basis(n, &t1, &t2);
+    return v3_normalize(t1);
+}
+
 void contact_match_points(contact_data *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
                           xform xa)
 {

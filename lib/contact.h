@@ -110,6 +110,11 @@ int contact_append(contact_set *cs, int a, int b, uint32_t sub);
 int contact_set_index(contact_set *cs, int *repeated);
 /* Swap-removes contact i. */
 void contact_remove(contact_set *cs, int i);
+/* The friction basis's first vector the solver builds for normal n when it
+ * keeps none (v3_basis, normalised; zero for a zero n): a sleeping pair's
+ * basis is re-expressed in it (collision.c), and the snapshot predicts a
+ * kept basis from it. */
+vec3 contact_rest_basis(vec3 n);
 /* Carries warm-start impulses from the old manifold to the new one. */
 void contact_match_points(contact_data *c, const manifold *old_m, const contact_point_state old[MANIFOLD_MAX_POINTS],
                           xform xa);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include "world.h"
 #include "island.h"
+#include "collision.h"
 
 static int find_root(int *parent, int i)
 {
@@ -71,7 +72,7 @@ void world_update_sleep(carom_world *w, const step_context *ctx)
         if (s->type[i] == CAROM_BODY_STATIC) continue;
         if (s->sleep_time[i] < def->sleep_time) restless[find_root(parent, i)] = 1;
     }
-    int islands = 0, awake = 0;
+    int islands = 0, awake = 0, slept = 0;
     for (int i = 0; i < n; i++) {
         if (s->type[i] == CAROM_BODY_STATIC) continue;
         int r = find_root(parent, i);
@@ -84,8 +85,12 @@ void world_update_sleep(carom_world *w, const step_context *ctx)
             s->flags[i] &= ~(uint32_t)BODY_AWAKE;
             s->velocity[i] = v3_zero();
             s->angular_velocity[i] = v3_zero();
+            world_settle_body(w, i);
+            slept++;
         }
     }
+    /* the pairs of the islands that fell asleep keep only what their bodies reproduce */
+    if (slept > 0) world_settle_contacts(w);
     w->stats.islands = islands;
     w->stats.awake_bodies = awake;
 }

@@ -1089,13 +1089,7 @@ enum { CREC_HAS_NORMAL = 8, CREC_FLIP = 16, CREC_SUB = 32, CREC_SUB_LIMIT = 64, 
 
 /* The friction basis the solver starts from for a normal (solver.c): the
  * kept basis of a resting contact is usually this, to the last bits. */
-static vec3 basis_guess(vec3 n)
-{
-    if (v3_is_zero(n)) return n;
-    vec3 t1, t2;
-    v3_basis(n, &t1, &t2);
-    return v3_normalize(t1);
-}
+static vec3 basis_guess(vec3 n) { return contact_rest_basis(n); }
 
 /* A manifold normal is read while the pair touches, or touched last step (its
  * end event); otherwise the next collision test rewrites it before anything

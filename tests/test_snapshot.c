@@ -530,6 +530,176 @@ static void test_restored_pair_map(void **state)
     }
 }
 
+/* A heap at rest on a slope and on the ground: a box on a 20 degree slope
+ * (friction 0.6 > tan 20 deg, so static friction holds it), a 3-box stack,
+ * a sphere, capsule, cylinder and hull. Steps until every body sleeps (at
+ * most 1200). slope/top: the slope box and the stack's top box. */
+static carom_world *sleeping_heap(carom_body_id *slope, carom_body_id *top)
+{
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    assert_non_null(w);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(w, &g);
+    const double tilt = 20.0 * PI_ / 180.0;
+    g.shape = carom_shape_box(2, 2, 0.1);
+    g.position = vec(-4, 0, 1);
+    g.orientation.w = cos(tilt / 2);
+    g.orientation.y = sin(tilt / 2);
+    carom_body_create(w, &g);
+    carom_body_def b = carom_body_def_default();
+    b.shape = carom_shape_box(0.2, 0.2, 0.2);
+    b.orientation = g.orientation;
+    /* on the slope's top face, 1 cm above it */
+    b.position = vec(-4 + 0.31 * sin(tilt), 0, 1 + 0.31 * cos(tilt));
+    *slope = carom_body_create(w, &b);
+    b.orientation.w = 1;
+    b.orientation.x = b.orientation.y = b.orientation.z = 0;
+    for (int k = 0; k < 3; k++) {
+        b.position = vec(2, 0, 0.2 + 0.4 * k + 0.001 * k);
+        *top = carom_body_create(w, &b);
+    }
+    static const double tetra[] = {0, 0, 0, 0.3, 0, 0, 0, 0.3, 0, 0, 0, 0.3, 0.2, 0.2, 0.2};
+    const carom_shape_def round[] = {carom_shape_sphere(0.2), carom_shape_capsule(0.1, 0.2), carom_shape_cylinder(0.15, 0.1),
+                                     carom_shape_hull(tetra, 5)};
+    carom_material mat = carom_material_default();
+    mat.rolling_resistance = 0.3; /* round bodies come to rest */
+    for (int k = 0; k < 4; k++) {
+        carom_body_def r = carom_body_def_default();
+        r.shape = round[k];
+        r.material = &mat;
+        r.position = vec(0.6 * k, 2, 0.3);
+        carom_body_create(w, &r);
+    }
+    carom_world_stats st = carom_world_stats_init();
+    for (int k = 0; k < 1200; k++) {
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        carom_world_get_stats(w, &st);
+        if (st.awake_bodies == 0) break;
+    }
+    if (st.awake_bodies != 0) fail_msg("%d bodies still awake after 1200 steps", st.awake_bodies);
+    return w;
+}
+
+/* When an island falls asleep its pairs keep only what the bodies' state
+ * reproduces (collision.c, world_settle_contacts): the snapshot writes no
+ * reuse pose, gap, A-frame normal, cache normal, friction basis or fat
+ * bounds for it. Woken, the heap holds still (the box on the slope does not
+ * slip: its friction impulses were re-expressed, not dropped), and a world
+ * restored from the sleeping heap's snapshot wakes and continues bit for bit
+ * with the original. */
+static void test_sleeping_pairs_settled(void **state)
+{
+    (void)state;
+    carom_body_id slope, top;
+    carom_world *w = sleeping_heap(&slope, &top);
+    /* a pair whose normal holds still keeps the basis the solver first built
+     * from it, the one a settled pair gets: turn the slope box's by 60
+     * degrees about the normal (its impulses re-expressed in it), wake it
+     * and let it fall asleep again (the basis is kept meanwhile) */
+    int slope_contact = contact_find(&w->contacts, 1, (int)slope.index1 - 1);
+    assert_true(slope_contact >= 0);
+    {
+        contact_data *d = CONTACT_DATA(&w->contacts, slope_contact);
+        assert_true(d->m.count > 0);
+        vec3 n = d->m.normal, t1 = d->tangent1, t2 = v3_cross(n, t1);
+        vec3 u1 = v3_add(v3_scale(t1, cos(PI_ / 3)), v3_scale(t2, sin(PI_ / 3))), u2 = v3_cross(n, u1);
+        for (int k = 0; k < d->m.count; k++) {
+            double *ti = d->state[k].tangent_impulse;
+            vec3 j = v3_add(v3_scale(t1, ti[0]), v3_scale(t2, ti[1]));
+            ti[0] = v3_dot(j, u1);
+            ti[1] = v3_dot(j, u2);
+        }
+        d->tangent1 = u1;
+        assert_int_equal(carom_body_set_awake(w, slope, 1), CAROM_OK);
+        carom_world_stats st = carom_world_stats_init();
+        int k = 0;
+        do {
+            assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+            carom_world_get_stats(w, &st);
+        } while (st.awake_bodies > 0 && ++k < 600);
+        assert_int_equal(st.awake_bodies, 0);
+        slope_contact = contact_find(&w->contacts, 1, (int)slope.index1 - 1);
+        assert_true(slope_contact >= 0);
+        d = CONTACT_DATA(&w->contacts, slope_contact);
+        vec3 rest = contact_rest_basis(d->m.normal);
+        assert_memory_equal(&d->tangent1, &rest, sizeof rest);
+    }
+    size_t bytes[SNAP_FIELD_COUNT];
+    const char *names[SNAP_FIELD_COUNT];
+    snapshot_field_bytes(w, bytes, names);
+    const int settled[] = {SNAP_FIELD_contact_rel_position, SNAP_FIELD_contact_rel_rotation, SNAP_FIELD_contact_gap,
+                           SNAP_FIELD_contact_reach, SNAP_FIELD_contact_normal_a, SNAP_FIELD_contact_cache_normal,
+                           SNAP_FIELD_body_fat, SNAP_FIELD_point_world};
+    for (int k = 0; k < (int)(sizeof settled / sizeof settled[0]); k++)
+        if (bytes[settled[k]]) fail_msg("a sleeping heap writes %zu bytes of %s", bytes[settled[k]], names[settled[k]]);
+    /* a kept friction basis is written as its two tag bytes alone (equal to its prediction) */
+    size_t kept = 0;
+    for (int i = 0; i < w->contacts.count; i++) {
+        vec3 t1 = CONTACT_DATA(&w->contacts, i)->tangent1;
+        kept += t1.x != 0 || t1.y != 0 || t1.z != 0;
+    }
+    if (bytes[SNAP_FIELD_contact_basis] != 2 * kept)
+        fail_msg("%zu kept friction bases take %zu bytes, not 2 each", kept, bytes[SNAP_FIELD_contact_basis]);
+    assert_true(bytes[SNAP_FIELD_point_local] > 0 && bytes[SNAP_FIELD_point_normal_impulse] > 0);
+    {
+        /* the settled friction impulses still hold the box on the slope: the
+         * warm-start impulses (per sub-step) times the sub-steps over dt are
+         * the contact force, m g cos 20 deg along the normal and m g sin 20
+         * deg up the slope */
+        const double tilt = 20.0 * PI_ / 180.0, m = 1000.0 * 0.4 * 0.4 * 0.4;
+        const contact_data *d = CONTACT_DATA(&w->contacts, slope_contact);
+        assert_true(d->m.count > 0);
+        vec3 n = d->m.normal, t1 = d->tangent1, t2 = v3_cross(n, t1), ft = v3(0, 0, 0);
+        double fn = 0, scale = w->def.substeps * 60.0;
+        for (int k = 0; k < d->m.count; k++) {
+            fn += d->state[k].normal_impulse * scale;
+            ft = v3_add(ft, v3_scale(v3_add(v3_scale(t1, d->state[k].tangent_impulse[0]), v3_scale(t2, d->state[k].tangent_impulse[1])), scale));
+        }
+        /* A is the slope (id 1); the impulses are those on B, the box */
+        vec3 up_slope = v3(-cos(tilt), 0, sin(tilt));
+        EXPECT_NEAR(fn, m * G * cos(tilt), 0.01 * m * G, "settled normal force (N)");
+        EXPECT_NEAR(v3_dot(ft, up_slope), m * G * sin(tilt), 0.01 * m * G, "settled friction force up the slope (N)");
+        EXPECT_NEAR(v3_len(ft), m * G * sin(tilt), 0.01 * m * G, "settled friction force (N)");
+    }
+    snap s = take(w);
+    char msg[256];
+    carom_world *r = carom_world_restore(s.data, s.size, msg, sizeof msg);
+    if (!r) fail_msg("restore refused: %s", msg);
+    carom_vec3 p0, t0;
+    assert_int_equal(carom_body_get_position(w, slope, &p0), CAROM_OK);
+    assert_int_equal(carom_body_get_position(w, top, &t0), CAROM_OK);
+    assert_int_equal(carom_body_set_awake(w, slope, 1), CAROM_OK);
+    assert_int_equal(carom_body_set_awake(w, top, 1), CAROM_OK);
+    assert_int_equal(carom_body_set_awake(r, slope, 1), CAROM_OK);
+    assert_int_equal(carom_body_set_awake(r, top, 1), CAROM_OK);
+    for (int k = 1; k <= 240; k++) {
+        assert_int_equal(carom_world_step(w, 1.0 / 60), CAROM_OK);
+        assert_int_equal(carom_world_step(r, 1.0 / 60), CAROM_OK);
+        snap a = take(w), c = take(r);
+        assert_same_snap(a, c, k);
+        free(a.data);
+        free(c.data);
+        if (k == 1 || k == 240) {
+            carom_vec3 p, t;
+            assert_int_equal(carom_body_get_position(w, slope, &p), CAROM_OK);
+            assert_int_equal(carom_body_get_position(w, top, &t), CAROM_OK);
+            double slip = sqrt((p.x - p0.x) * (p.x - p0.x) + (p.y - p0.y) * (p.y - p0.y) + (p.z - p0.z) * (p.z - p0.z));
+            double sway = sqrt((t.x - t0.x) * (t.x - t0.x) + (t.y - t0.y) * (t.y - t0.y) + (t.z - t0.z) * (t.z - t0.z));
+            print_message("woken %d steps: slope box moved %.3g m, stack top %.3g m\n", k, slip, sway);
+            /* static friction holds the box: no slip beyond the contact's
+             * micrometre creep, and the stack stays where it slept */
+            assert_true(slip < 1e-4);
+            assert_true(sway < 1e-4);
+        }
+    }
+    free(s.data);
+    carom_world_destroy(r);
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -540,6 +710,7 @@ int main(void)
         cmocka_unit_test(test_contact_materials_predicted),
         cmocka_unit_test(test_field_bytes_add_up),
         cmocka_unit_test(test_restored_pair_map),
+        cmocka_unit_test(test_sleeping_pairs_settled),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
