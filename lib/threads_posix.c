@@ -1,14 +1,30 @@
 /* threads_posix.c - the reference task hooks (carom_threads.h): a pool of
- * POSIX threads. A task is cut into at most four ranges per worker (fewer
+ * POSIX threads. A task is cut into at most eight ranges per worker (fewer
  * when min_range asks for longer ones); workers and the thread waiting in
- * finish claim them one at a time under the pool's lock. */
+ * finish claim them one at a time under the pool's lock. A thread with
+ * nothing to do polls briefly for the next task (or, in finish, for the last
+ * range) before it blocks: a step hands over some 150 tasks back to back
+ * (a pass per colour per sub-step), and waking a blocked thread costs tens
+ * of microseconds, more on a virtual machine. */
 #define _POSIX_C_SOURCE 200809L
 #include <pthread.h>
+#include <sched.h>
+#include <time.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include "carom/carom_threads.h"
 
-#define RANGES_PER_WORKER 4
+/* Eight, not four: the last range of a task ends alone, so the task's tail
+ * (one worker busy, the rest waiting) is a range long; a range claim costs
+ * a lock, far below a range's work (min_range sees to that). */
+#define RANGES_PER_WORKER 8
+/* How long a thread with nothing to claim polls before it blocks: longer
+ * than the gap between two passes of a step, far shorter than a frame's
+ * gap between steps. The first polls pause; later ones yield the core, so
+ * that on a machine with more runnable threads than cores a poller gives
+ * its time to the threads with work. */
+#define POLL_NS 100000L
+#define POLLS_PAUSING 64
 
 struct carom_thread_pool {
     int workers;
@@ -23,7 +39,43 @@ struct carom_thread_pool {
     int item_count, range_size, range_count;
     int next_range, done_ranges;
     int busy, stop;
+    int task_seq; /* counts enqueued tasks (and the stop): what a polling worker watches */
 };
+
+/* One poll's wait: tells the core (and a hyperthread sibling) that this is a spin. */
+static void cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    __asm__ __volatile__("yield");
+#endif
+}
+
+static long elapsed_ns(const struct timespec *t0)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (long)(t.tv_sec - t0->tv_sec) * 1000000000L + (t.tv_nsec - t0->tv_nsec);
+}
+
+/* Polls *word, which other threads change under the pool's lock (with an
+ * atomic store, so this unlocked read is not a race), until it differs from
+ * seen: 1 when it did within POLL_NS, else 0. Called without the lock. */
+static int poll_for_change(const int *word, int seen)
+{
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (int i = 0;; i++) {
+        if (__atomic_load_n(word, __ATOMIC_ACQUIRE) != seen) return 1;
+        if (i < POLLS_PAUSING) {
+            cpu_relax();
+            continue;
+        }
+        if (elapsed_ns(&t0) > POLL_NS) return 0;
+        sched_yield();
+    }
+}
 
 /* Claims and runs ranges of the task in flight until none is left; called
  * and returns with the lock held. */
@@ -38,7 +90,8 @@ static void work_on_task(carom_thread_pool *p, int worker)
         pthread_mutex_unlock(&p->lock);
         task(begin, end, worker, data);
         pthread_mutex_lock(&p->lock);
-        if (++p->done_ranges == p->range_count) pthread_cond_signal(&p->work_done);
+        if (__atomic_add_fetch(&p->done_ranges, 1, __ATOMIC_RELEASE) == p->range_count)
+            pthread_cond_signal(&p->work_done);
     }
 }
 
@@ -55,9 +108,18 @@ static void *worker_main(void *arg)
     free(start);
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (!p->stop && !(p->busy && p->next_range < p->range_count)) pthread_cond_wait(&p->work_ready, &p->lock);
         if (p->stop) break;
-        work_on_task(p, worker);
+        if (p->busy && p->next_range < p->range_count) {
+            work_on_task(p, worker);
+            continue;
+        }
+        /* nothing to claim: poll for the next task, then block (re-checked
+         * under the lock, so an enqueue between the two is never missed) */
+        int seen = p->task_seq;
+        pthread_mutex_unlock(&p->lock);
+        int changed = poll_for_change(&p->task_seq, seen);
+        pthread_mutex_lock(&p->lock);
+        if (!changed && p->task_seq == seen) pthread_cond_wait(&p->work_ready, &p->lock);
     }
     pthread_mutex_unlock(&p->lock);
     return NULL;
@@ -114,6 +176,7 @@ CAROM_API void carom_thread_pool_destroy(carom_thread_pool *p)
     if (!p) return;
     pthread_mutex_lock(&p->lock);
     p->stop = 1;
+    __atomic_store_n(&p->task_seq, p->task_seq + 1, __ATOMIC_RELEASE);
     pthread_cond_broadcast(&p->work_ready);
     pthread_mutex_unlock(&p->lock);
     for (int k = 0; k < p->threads_started; k++) pthread_join(p->threads[k], NULL);
@@ -160,8 +223,9 @@ CAROM_API void *carom_thread_pool_enqueue(carom_task_fn *task, int item_count, i
     p->range_size = (item_count + ranges - 1) / ranges;
     p->range_count = (item_count + p->range_size - 1) / p->range_size;
     p->next_range = 0;
-    p->done_ranges = 0;
+    __atomic_store_n(&p->done_ranges, 0, __ATOMIC_RELAXED);
     p->busy = 1;
+    __atomic_store_n(&p->task_seq, p->task_seq + 1, __ATOMIC_RELEASE);
     pthread_cond_broadcast(&p->work_ready);
     pthread_mutex_unlock(&p->lock);
     return p;
@@ -173,7 +237,14 @@ CAROM_API void carom_thread_pool_finish(void *task, void *pool)
     if (!task) return;
     pthread_mutex_lock(&p->lock);
     work_on_task(p, 0); /* the waiting thread is worker 0 */
-    while (p->done_ranges < p->range_count) pthread_cond_wait(&p->work_done, &p->lock);
+    while (p->done_ranges < p->range_count) {
+        /* the last ranges run elsewhere: poll for them, then block */
+        int done = p->done_ranges;
+        pthread_mutex_unlock(&p->lock);
+        int changed = poll_for_change(&p->done_ranges, done);
+        pthread_mutex_lock(&p->lock);
+        if (!changed && p->done_ranges == done) pthread_cond_wait(&p->work_done, &p->lock);
+    }
     p->busy = 0;
     pthread_mutex_unlock(&p->lock);
 }
