@@ -5,6 +5,11 @@
  * below it (its face, and side walls at its edges), so the separating-axis
  * test only ever finds normals on the front side. Spheres and capsules take
  * the face when their core projects onto it, else the nearest edge or vertex.
+ * Cylinders take the polytope path with their true shape on every axis: the
+ * face's gap from the true lowest point, the caps (exact faces) but not the
+ * prism's side facets, and each edge's axes searched along its arc of the
+ * Gauss map with the exact support (cyl_edge_axis); the face contact uses
+ * the true line of support and deepest rim point.
  *
  * Internal edges: each triangle edge is flagged active when its neighbour is
  * folded away from it (a convex crease of more than 5 degrees) or missing
@@ -160,6 +165,96 @@ static void add_rim_point(const vec3 v[3], vec3 n, const shape *cyl, xform x, do
     m->normal = n;
 }
 
+/* The cylinder's true point farthest along unit u (world). */
+static vec3 cyl_support(const shape *cyl, xform x, vec3 u)
+{
+    return xf_point(x, shape_support_local(cyl, q_inv_rotate(x.q, u)));
+}
+
+/* A cylinder in world space: centre, unit axis, half height, radius. */
+typedef struct cyl_world { vec3 c, a; double hh, r; } cyl_world;
+
+static cyl_world cyl_world_of(const shape *cyl, xform x)
+{
+    cyl_world cw = {x.p, q_rotate(x.q, v3(0, 0, 1)), cyl->half_height, cyl->radius};
+    return cw;
+}
+
+/* The exact room between the cylinder and the one-sided triangle (the prism
+ * below it) along unit u with u . n >= 0: the cylinder's lowest point along
+ * u (its support along -u in closed form) less the triangle's highest
+ * vertex. */
+static double cyl_gap(const vec3 v[3], const cyl_world *cw, vec3 u)
+{
+    double top = dmax(v3_dot(u, v[0]), dmax(v3_dot(u, v[1]), v3_dot(u, v[2])));
+    double au = v3_dot(cw->a, u);
+    double radial2 = dmax(0, 1 - au * au); /* |u without its axial part|^2 */
+    return v3_dot(u, cw->c) - cw->hh * fabs(au) - cw->r * sqrt(radial2) - top;
+}
+
+/* The best axis of edge k's part of the Gauss map, the arc from the face
+ * normal n to the edge's side wall, for the true cylinder: the arc's
+ * directions normalize((1 - l) n + l side) for l in [0, 1], a scan of 9,
+ * then a golden-section search around the best (no trigonometry). The
+ * prism's edge pairs read up to its sagitta too far; any axis's gap here is
+ * exact, so the best found is never more room than there is. Returns the
+ * gap and sets *u; the face's own axis (l = 0) returns -1e300. */
+static vec3 arc_dir(vec3 n, vec3 side, double l) { return v3_normalize(v3_add(v3_scale(n, 1 - l), v3_scale(side, l))); }
+
+static double cyl_edge_axis(const vec3 v[3], vec3 n, int k, const cyl_world *cw, vec3 *u)
+{
+    vec3 side = edge_side(v, n, k);
+    double best = -1e300, bl = 0;
+    for (int i = 0; i <= 8; i++) {
+        double l = i / 8.0, g = cyl_gap(v, cw, arc_dir(n, side, l));
+        if (g > best) { best = g; bl = l; }
+    }
+    double lo = dmax(0, bl - 0.125), hi = dmin(1, bl + 0.125);
+    const double r = 0.6180339887498949;
+    double l1 = hi - r * (hi - lo), l2 = lo + r * (hi - lo);
+    double g1 = cyl_gap(v, cw, arc_dir(n, side, l1)), g2 = cyl_gap(v, cw, arc_dir(n, side, l2));
+    for (int it = 0; it < 24; it++) {
+        if (g1 > g2) { hi = l2; l2 = l1; g2 = g1; l1 = hi - r * (hi - lo); g1 = cyl_gap(v, cw, arc_dir(n, side, l1)); }
+        else { lo = l1; l1 = l2; g1 = g2; l2 = lo + r * (hi - lo); g2 = cyl_gap(v, cw, arc_dir(n, side, l2)); }
+    }
+    if (g1 > best) { best = g1; bl = l1; }
+    if (g2 > best) { best = g2; bl = l2; }
+    if (!(bl > 1e-9)) return -1e300; /* the face's own axis: not this edge's */
+    *u = arc_dir(n, side, bl);
+    return best;
+}
+
+/* A cylinder against the triangle along an edge's axis u (gap sep): the
+ * cylinder's lowest point along u, or, its side square to u, the side's
+ * line clipped to the edge's span (a log lying along a border edge rests on
+ * two points). */
+static void cyl_edge_contact(const vec3 v[3], int k, const shape *cyl, xform x, vec3 u, double sep, double spec,
+                             manifold *m)
+{
+    m->normal = u;
+    vec3 axis = q_rotate(x.q, v3(0, 0, 1));
+    double top = dmax(v3_dot(u, v[0]), dmax(v3_dot(u, v[1]), v3_dot(u, v[2])));
+    vec3 radial = v3_madd(v3_neg(u), v3_dot(u, axis), axis);
+    if (fabs(v3_dot(axis, u)) < 2e-2 && v3_len2(radial) > 1e-12) {
+        radial = v3_normalize(radial);
+        vec3 e0 = v3_add(v3_madd(x.p, -cyl->half_height, axis), v3_scale(radial, cyl->radius));
+        vec3 e1 = v3_add(v3_madd(x.p, cyl->half_height, axis), v3_scale(radial, cyl->radius));
+        vec3 a = v[k], ed = v3_sub(v[(k + 1) % 3], a);
+        double el2 = v3_len2(ed), s0 = v3_dot(v3_sub(e0, a), ed) / el2, s1 = v3_dot(v3_sub(e1, a), ed) / el2;
+        double lo = dmax(0, dmin(s0, s1)), hi = dmin(1, dmax(s0, s1));
+        if (hi > lo + 1e-9 && fabs(s1 - s0) > 1e-12) {
+            for (int i = 0; i < 2; i++) {
+                vec3 q = v3_lerp(e0, e1, ((i ? hi : lo) - s0) / (s1 - s0));
+                double sq = v3_dot(u, q) - top;
+                if (sq < spec) push_point(m, v3_madd(q, -0.5 * sq, u), sq, 0x4800u | ((uint32_t)k << 12) | (uint32_t)i);
+            }
+            if (m->count > 0) return;
+        }
+    }
+    vec3 q = cyl_support(cyl, x, v3_neg(u));
+    if (sep < spec) push_point(m, v3_madd(q, -0.5 * sep, u), sep, 0x4800u | ((uint32_t)k << 12) | 2u);
+}
+
 /* Whether edge k is active and the contact normal -fn (from the triangle
  * to the shape) leans out across it: an edge or vertex speaks only for
  * normals in its own part of the Gauss map. A vertex where a mesh's
@@ -252,14 +347,21 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
     double d = v3_dot(n, v[0]);
     m->normal = n;
     if (v3_dot(n, p->center) - d < 0) return; /* behind a one-sided face */
+    /* a cylinder is its true shape on every axis below (its prism's
+     * vertices lie on the rims, but between them the rims and the round
+     * side reach up to the sagitta r (1 - cos(pi/16)) farther) */
+    const shape *cyl = s->type == SHAPE_CYLINDER ? s : NULL;
+    cyl_world cw = cyl_world_of(s, xs);
     double sep_t = 1e300;
-    for (int i = 0; i < p->nv; i++) sep_t = dmin(sep_t, v3_dot(n, p->v[i]));
+    if (cyl) sep_t = v3_dot(n, cyl_support(cyl, xs, v3_neg(n)));
+    else
+        for (int i = 0; i < p->nv; i++) sep_t = dmin(sep_t, v3_dot(n, p->v[i]));
     sep_t -= d;
     if (sep_t > spec) return;
     /* the polytope's faces whose outward normal looks at the triangle's front */
     double sep_f = -1e300;
     int best_f = -1;
-    for (int f = 0; f < p->nf; f++) {
+    for (int f = cyl ? CYL_SIDES : 0; f < p->nf; f++) { /* a cylinder's caps only: its facets are not its surface */
         if (v3_dot(p->fn[f], n) > 1e-9) continue;
         double sv = 1e300;
         for (int k = 0; k < 3; k++) sv = dmin(sv, v3_dot(p->fn[f], v[k]));
@@ -272,7 +374,16 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
     double sep_e = -1e300;
     int ek = -1, ej = -1;
     vec3 en = n;
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3 && cyl; k++) {
+        /* the cylinder: the best axis of each active edge's arc (an
+         * internal edge's axes are never used: its contacts take the face) */
+        vec3 u;
+        if (!(active >> k & 1u)) continue;
+        double sv = cyl_edge_axis(v, n, k, &cw, &u);
+        if (sv > spec) { m->normal = u; return; }
+        if (sv > sep_e) { sep_e = sv; ek = k; en = u; }
+    }
+    for (int k = 0; k < 3 && !cyl; k++) {
         vec3 a0 = v[k], da = v3_sub(v[(k + 1) % 3], a0);
         vec3 na = n, nb = edge_side(v, n, k);
         vec3 bxa = v3_cross(nb, na);
@@ -295,10 +406,15 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
     }
     /* the triangle's face first (a resting shape keeps it, and contacts from
      * internal edges are turned to it) */
-    const shape *cyl = s->type == SHAPE_CYLINDER ? s : NULL;
     poly t;
     triangle_poly(&t, v, n);
     poly_face_contact(&t, 0, p, cyl, xs, 0, spec, 0, m);
+    /* a cylinder: its true line of support or deepest rim point, and no
+     * other round points (a rim point beside the deepest, where the rim
+     * crosses an edge of the triangle, is a point of the body that a
+     * rolling cylinder moves down onto the floor: a speculative contact
+     * there braked it, 0.5 m/s off the slope on a tessellated incline; the
+     * neighbouring triangle holds the deepest point) */
     if (cyl) add_rim_point(v, n, s, xs, spec, m);
     /* another axis that separates more, from an active feature of the
      * triangle, replaces it when its contact is nearer: the face's points,
@@ -312,13 +428,16 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
     double prefer_face = beside ? 0 : TRI_FACE_TOLERANCE;
     if (ek >= 0 && (active >> ek & 1u) &&
         (beside ? !(best_f >= 0 && sep_f > sep_e) : sep_e > dmax(sep_t, sep_f) + TRI_FACE_TOLERANCE)) {
-        vec3 ca, cb;
-        closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
-        alt.normal = en;
-        push_point(&alt, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
+        if (cyl) {
+            cyl_edge_contact(v, ek, cyl, xs, en, sep_e, spec, &alt);
+        } else {
+            vec3 ca, cb;
+            closest_segments(v[ek], v[(ek + 1) % 3], p->v[p->e[ej][0]], p->v[p->e[ej][1]], &ca, &cb);
+            alt.normal = en;
+            push_point(&alt, v3_scale(v3_add(ca, cb), 0.5), sep_e, 0x4000u | ((uint32_t)ek << 12) | (uint32_t)(ej & 0xfff));
+        }
     } else if (best_f >= 0 && (beside || sep_f > sep_t + TRI_FACE_TOLERANCE) &&
-               !(ek >= 0 && (active >> ek & 1u) && sep_e > sep_f + prefer_face) &&
-               (beside || !(cyl && best_f < CYL_SIDES))) { /* a prism facet only approximates a round side */
+               !(ek >= 0 && (active >> ek & 1u) && sep_e > sep_f + prefer_face)) {
         poly_face_contact(p, best_f, &t, NULL, xs, 1, spec, 0x20000000u, &alt);
         if (alt.count > 0 && !face_contact_active(v, n, active, p->fn[best_f], &alt, !beside)) alt.count = 0;
     }
@@ -331,6 +450,23 @@ static void triangle_polytope(const vec3 v[3], vec3 n, unsigned active, const po
      * (the face's points, clipped to the triangle, can all lie above its
      * plane while the shape's side cuts into a border edge) */
     double bound = dmax(sep_t, dmax(sep_f, sep_e));
+    if (cyl && m->count > 0) {
+        /* the internal edges' arcs bound the room too; searched only when
+         * the bound would move a point (a cylinder over the neighbour, its
+         * lowest line beside this triangle, was held as deep as that line
+         * and rolled off its plane path by up to 0.4 mm more) */
+        int moves = 0;
+        double deepest = 1e300;
+        for (int i = 0; i < m->count; i++) {
+            deepest = dmin(deepest, m->points[i].separation);
+            if (bound > 0 && m->points[i].separation > bound) moves = 1;
+        }
+        if (bound <= 0 && deepest > bound) moves = 1;
+        for (int k = 0; k < 3 && moves; k++) {
+            vec3 u;
+            if (!(active >> k & 1u)) bound = dmax(bound, cyl_edge_axis(v, n, k, &cw, &u));
+        }
+    }
     if (bound > 0) {
         for (int i = 0; i < m->count; i++) m->points[i].separation = dmin(m->points[i].separation, bound);
     } else if (m->count > 0) {

@@ -17,10 +17,12 @@
  * over the face, the depth of the shape's lowest point) is within the
  * look-ahead; the normal is unit and on the front side; no contact claims
  * more room than gap() along its own normal; spheres and capsules get
- * exactly the signed distance. Cylinders are 16-sided prisms with vertices
- * on the true rims: they may read up to the sagitta r (1 - cos(pi/16)) too
- * far, no more. With every edge internal a contact has the face normal, and
- * no point is deeper than the shape's lowest point along it. */
+ * exactly the signed distance. Cylinders too are held to 1e-7 m: they collide
+ * as the true round shape (as 16-sided prisms they read up to the sagitta
+ * r (1 - cos(pi/16)) = 5.8 mm too far here, and only 63 of 244 contacts had
+ * the distance; now more than half must). With every edge internal a
+ * contact has the face normal, and no point is deeper than the shape's
+ * lowest point along it. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -246,12 +248,6 @@ typedef struct pair_stats {
     int poor_normal;         /* apart, gap() along the contact's normal 1 mm short of its separation */
 } pair_stats;
 
-/* How much farther a cylinder's prism may read than the true cylinder. */
-static double sagitta_of(const shape *s)
-{
-    return s->type == SHAPE_CYLINDER ? s->radius * (1 - cos(PI_ / CYL_SIDES)) : 0;
-}
-
 /* One pose: the brute force, then every check. */
 static void check_pose(const shape *s, xform x, double tol, int trial, pair_stats *st)
 {
@@ -269,7 +265,7 @@ static void check_pose(const shape *s, xform x, double tol, int trial, pair_stat
     int depth = !known && depth_low < 0 ? 2 : d > 1e-4 ? 0 : d > -1e-4 ? 1 : 2;
     manifold m;
     collide_triangle(tri, 7u, 0, s, x, SPEC, &m);
-    if (d < SPEC - sagitta_of(s) - 1e-6 && m.count == 0) {
+    if (d < SPEC - 1e-6 && m.count == 0) {
         /* beside the triangle the nearest features can be a vertex and an
          * edge or two vertices, axes the separating-axis test does not try:
          * then the closest points give the look-ahead contact (before: 1
@@ -349,8 +345,7 @@ static void check_shape(int type)
 {
     shape s = make_shape(type);
     vec3 n = face_normal();
-    const double sagitta = sagitta_of(&s);
-    const double tol = 1e-7 + sagitta;
+    const double tol = 1e-7;
     unsigned seed = 17u + (unsigned)type;
     pair_stats st;
     memset(&st, 0, sizeof st);
@@ -387,6 +382,8 @@ static void check_shape(int type)
            type_name(type), st.checked, st.exact, st.worst_extra, st.poor_normal, st.internal_checked, st.missed_beside,
            st.seen[0][0], st.seen[0][1], st.seen[0][2], st.seen[1][0], st.seen[1][1], st.seen[1][2], st.seen[2][0],
            st.seen[2][1], st.seen[2][2]);
+    /* the true cylinder: at the distance itself mostly (the prism: 63 of 244) */
+    if (type == SHAPE_CYLINDER) assert_true(2 * st.exact > st.checked);
     /* each region apart, touching and deep */
     for (int r = 0; r < 3; r++)
         for (int k = 0; k < 3; k++) assert_true(st.seen[r][k] >= 1);
