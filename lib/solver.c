@@ -25,6 +25,7 @@
  *
  * A new pass over the constraints plugs in as a stage here, with a scalar
  * verb in contact_solver.c and, if it is hot, a wide one in solver_wide.c. */
+#define _POSIX_C_SOURCE 200809L /* posix_memalign */
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
@@ -192,9 +193,17 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     if (!array_reserve((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
     /* the per-body scratch arrays share one capacity */
     int cap = s->body_capacity;
-    void *p1 = realloc(s->bodies, sizeof *s->bodies * (size_t)cap);
-    if (!p1) return 0;
-    s->bodies = p1;
+    if (cap > s->solver.bodies_capacity || !s->bodies) {
+        /* 64-byte aligned (nothing in them outlives the step): a solver
+         * body's velocities and inverse mass, what the passes read of it,
+         * then lie in one cache line; realloc's large blocks begin 16 bytes
+         * into a page, which split every one of them over two */
+        void *p1 = NULL;
+        if (posix_memalign(&p1, 64, sizeof *s->bodies * (size_t)cap) != 0) return 0;
+        free(s->bodies);
+        s->bodies = p1;
+        s->solver.bodies_capacity = cap;
+    }
     void *p2 = realloc(s->delta_position, sizeof *s->delta_position * (size_t)cap);
     if (!p2) return 0;
     s->delta_position = p2;

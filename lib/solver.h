@@ -29,6 +29,7 @@ typedef struct solver_memory {
     int last_count, last_capacity, mark_capacity;
     void *motion;                /* per solver body: what its sub-steps read of it (body_step, solver.c) */
     int motion_capacity;
+    int bodies_capacity;         /* step_scratch.bodies' (gather_bodies) */
     int planar;                  /* this step: some awake body is locked to a plane */
 } solver_memory;
 void solver_memory_free(solver_memory *m);
