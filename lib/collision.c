@@ -1,6 +1,7 @@
 /* collision.c - the collision stage of the step: broadphase pair updates feed
  * the contact cache; the narrowphase refreshes every live contact's manifold
  * and raises begin/end events. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
@@ -607,9 +608,34 @@ int world_collide(carom_world *w, const step_context *ctx)
 
 /* ---- falling asleep: a cache the bodies' own state reproduces ----------------------- */
 
+/* A resting state is known to the solver's tolerance (micrometres), not to
+ * the last bit: a sleeping island's lengths (centres, orientation
+ * components, unit vectors, points in A's frame, separations) are rounded to
+ * multiples of 2^-30 (9.3e-10 m; a coordinate past 2^22 m keeps its own
+ * ulp), its impulses to 28 significant bits (relative 3.7e-9). Rounded
+ * values share their low bits, so a snapshot codes them in fewer bytes
+ * (docs/snapshot.md); the step reads them as it reads any value. */
+static double settle_length(double x) { return ldexp(nearbyint(ldexp(x, 30)), -30); }
+static vec3 settle_v3(vec3 v) { return v3(settle_length(v.x), settle_length(v.y), settle_length(v.z)); }
+static double settle_impulse(double x)
+{
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u = (u + ((uint64_t)1 << 23)) & ~(((uint64_t)1 << 24) - 1); /* to nearest (a carry into the exponent is right) */
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
 void world_settle_body(carom_world *w, int slot)
 {
     body_store *s = &w->bodies;
+    s->center[slot] = settle_v3(s->center[slot]);
+    quat q = s->rotation[slot];
+    /* (|q| stays within 2^-29 of 1: the step normalises it when it turns) */
+    s->rotation[slot] = (quat){settle_length(q.w), settle_length(q.x), settle_length(q.y), settle_length(q.z)};
+    body_update_inertia(s, slot);
+    /* asleep: past the island's threshold (what body_set_awake(0) sets) */
+    s->sleep_time[slot] = w->def.sleep_time;
     /* the pose its pairs are settled at (world_settle_contacts) */
     s->collided[slot] = body_xform(s, slot);
     /* bounds fattened about where it rests, as a body at rest's are
@@ -640,18 +666,22 @@ static void settle_contact(carom_world *w, int i)
     if (!normal_read) {
         c->cache.has_normal = 0;
         c->cache.normal = v3(0, 0, 0);
-    } else if (c->cache.has_normal) {
-        c->cache.normal = d0->m.normal;
     }
-    if (!c->slot) return;
+    if (!c->slot) {
+        if (c->cache.has_normal) c->cache.normal = settle_v3(c->cache.normal);
+        return;
+    }
     contact_data *d = CONTACT_DATA(cs, i);
+    if (normal_read) d->m.normal = settle_v3(d->m.normal);
+    if (c->cache.has_normal) c->cache.normal = normal_read ? d->m.normal : settle_v3(c->cache.normal);
     xform xa = s->collided[s->ids[c->id_a].slot];
     for (int k = 0; k < d->m.count; k++) {
         manifold_point *p = &d->m.points[k];
         contact_point_state *st = &d->state[k];
-        st->local_a = xf_inv_point(xa, p->point);
+        st->local_a = settle_v3(xf_inv_point(xa, p->point));
         p->point = xf_point(xa, st->local_a);
-        st->separation = p->separation;
+        p->separation = st->separation = settle_length(p->separation);
+        st->normal_impulse = settle_impulse(st->normal_impulse);
     }
     if (d->m.count == 0) {
         d->tangent1 = v3(0, 0, 0);
@@ -665,6 +695,10 @@ static void settle_contact(carom_world *w, int i)
             st->tangent_impulse[1] = v3_dot(j, u2);
         }
         d->tangent1 = u1;
+    }
+    for (int k = 0; k < d->m.count; k++) {
+        d->state[k].tangent_impulse[0] = settle_impulse(d->state[k].tangent_impulse[0]);
+        d->state[k].tangent_impulse[1] = settle_impulse(d->state[k].tangent_impulse[1]);
     }
     if (!(c->flags & (CONTACT_TOUCHING | CONTACT_ANY_TOUCHING)) && contact_data_idle(cs, i)) contact_data_release(cs, i);
 }

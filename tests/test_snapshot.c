@@ -627,6 +627,28 @@ static void test_sleeping_pairs_settled(void **state)
         vec3 rest = contact_rest_basis(d->m.normal);
         assert_memory_equal(&d->tangent1, &rest, sizeof rest);
     }
+    /* the rest state to 2^-30 (lengths) and 28 significant bits (impulses) */
+    for (int i = 0; i < w->contacts.count; i++) {
+        const contact_data *d = CONTACT_DATA(&w->contacts, i);
+        for (int k = 0; k < d->m.count; k++) {
+            const contact_point_state *st = &d->state[k];
+            double v[4] = {st->local_a.x, st->local_a.y, st->local_a.z, st->separation};
+            for (int j = 0; j < 4; j++)
+                if (ldexp(v[j], 30) != nearbyint(ldexp(v[j], 30))) fail_msg("contact %d point %d: %.17g not a multiple of 2^-30", i, k, v[j]);
+            double im[3] = {st->normal_impulse, st->tangent_impulse[0], st->tangent_impulse[1]};
+            for (int j = 0; j < 3; j++) {
+                uint64_t u;
+                memcpy(&u, &im[j], 8);
+                if (u & ((1u << 24) - 1)) fail_msg("contact %d point %d: impulse %.17g has more than 28 significant bits", i, k, im[j]);
+            }
+        }
+    }
+    for (int i = 0; i < w->bodies.count; i++) {
+        vec3 c = w->bodies.center[i];
+        if (w->bodies.type[i] == CAROM_BODY_DYNAMIC &&
+            (ldexp(c.x, 30) != nearbyint(ldexp(c.x, 30)) || ldexp(c.z, 30) != nearbyint(ldexp(c.z, 30))))
+            fail_msg("body %d: its centre is not on the 2^-30 m grid", i);
+    }
     size_t bytes[SNAP_FIELD_COUNT];
     const char *names[SNAP_FIELD_COUNT];
     snapshot_field_bytes(w, bytes, names);
