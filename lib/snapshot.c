@@ -26,7 +26,7 @@
 #include "snapshot.h"
 
 #define SNAP_MAGIC "CAROMSNP"
-#define SNAP_VERSION 5u
+#define SNAP_VERSION 6u
 #define SNAP_HEADER_SIZE 32u
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
@@ -958,6 +958,15 @@ static xform previous_pose(const body_store *s, int i)
     return x;
 }
 
+/* What the reader predicts a body's collided pose to be: an awake body's
+ * last pair test was at the start of the last step (its previous pose); a
+ * body that fell asleep had its pairs settled at the pose it rests at
+ * (collision.c, world_settle_body), x. */
+static xform collided_guess(const body_store *s, int i, xform x)
+{
+    return (s->flags[i] & BODY_AWAKE) ? previous_pose(s, i) : x;
+}
+
 /* body record bits */
 enum {
     REC_AWAKE = 1, REC_FORCE_FLAG = 2, REC_MOVED = 4, REC_VELOCITY = 8, REC_SPIN = 16, REC_FORCE = 32,
@@ -966,16 +975,25 @@ enum {
 
 /* A body's record bits, from its state: the writer's, and what the reader
  * checks it read (one encoding per state). */
-static unsigned body_bits(const body_store *s, int i, xform x, aabb fat, int moved)
+/* What the reader predicts a body's sleep timer to be: a sleeping body's is
+ * the world's threshold (what falling asleep and body_set_awake(0) set), an
+ * awake or static body's 0. */
+static double sleep_guess(const body_store *s, int i, double threshold)
 {
+    return (s->flags[i] & BODY_AWAKE) || s->type[i] == CAROM_BODY_STATIC ? 0.0 : threshold;
+}
+
+static unsigned body_bits(const body_store *s, int i, xform x, aabb fat, int moved, double threshold)
+{
+    xform guess = collided_guess(s, i, x);
     int same_fat = same_bits(&fat, &s->fat_box[i], sizeof fat);
     int same_previous = same_bits(&x.p, &s->previous_origin[i], sizeof x.p) && same_bits(&x.q, &s->previous_rotation[i], sizeof x.q);
     return ((s->flags[i] & BODY_AWAKE) ? REC_AWAKE : 0) | ((s->flags[i] & BODY_HAS_FORCE) ? REC_FORCE_FLAG : 0) |
            (moved ? REC_MOVED : 0) | (v3_is_zero(s->velocity[i]) ? 0 : REC_VELOCITY) |
            (v3_is_zero(s->angular_velocity[i]) ? 0 : REC_SPIN) | (v3_is_zero(s->force[i]) ? 0 : REC_FORCE) |
-           (f64_bits(s->sleep_time[i]) == 0 ? 0 : REC_SLEEP_TIME) | (same_previous ? 0 : REC_PREVIOUS) |
+           (f64_bits(s->sleep_time[i]) == f64_bits(sleep_guess(s, i, threshold)) ? 0 : REC_SLEEP_TIME) | (same_previous ? 0 : REC_PREVIOUS) |
            (same_fat ? 0 : REC_FAT) | (v3_is_zero(s->torque[i]) ? 0 : REC_TORQUE) |
-           (same_bits(&s->collided[i], &(xform){s->previous_origin[i], s->previous_rotation[i]}, sizeof(xform)) ? 0 : REC_COLLIDED);
+           (same_bits(&s->collided[i], &(xform){guess.p, guess.q}, sizeof(xform)) ? 0 : REC_COLLIDED);
 }
 
 static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
@@ -992,7 +1010,7 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t, 
     for (int i = 0; i < s->count; i++) {
         xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
-        unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]));
+        unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]), w->def.sleep_time);
         at = o->pos;
         put_varint(o, bits);
         put_varint(o, (uint64_t)t->of_body[i]);
@@ -1029,7 +1047,7 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t, 
         acct(o, SNAP_FIELD_body_previous, at);
         at = o->pos;
         if (bits & REC_COLLIDED) {
-            xform p = previous_pose(s, i);
+            xform p = collided_guess(s, i, x);
             put_coded_v3(o, s->collided[i].p, p.p);
             put_coded_q(o, s->collided[i].q, p.q);
         }
@@ -1082,10 +1100,14 @@ static void point_guess(const reuse_motion *m, const contact_data *d, xform xa, 
     *point = xf_point(xa, v3_madd(st->local_a, 0.5, moved));
 }
 
-/* contact record bits, after the point count (3 bits) */
-enum { CREC_HAS_NORMAL = 8, CREC_FLIP = 16, CREC_SUB = 32, CREC_SUB_LIMIT = 64, CREC_FEATURE = 128, CREC_TANGENT = 256,
-       CREC_NORMAL = 512, CREC_CACHE_NORMAL = 1024, CREC_MATERIAL = 2048, CREC_POSE = 4096, CREC_REACH = 8192,
-       CREC_NORMAL_A = 16384, CREC_EXACT = 32768, CREC_ALL = 65535 };
+/* contact record bits, after the point count (3 bits); a contact's head
+ * varint is its flags (6 bits) | bits << 6, so a touching manifold's usual
+ * record (count, feature, exact points, cache normal, basis as predicted,
+ * flip) fits its first 14 bits: two bytes */
+enum { CREC_FEATURE = 8, CREC_EXACT = 16, CREC_HAS_NORMAL = 32, CREC_TANGENT_GUESS = 64, CREC_FLIP = 128,
+       CREC_NORMAL = 256, CREC_SUB = 512, CREC_SUB_LIMIT = 1024, CREC_TANGENT = 2048, CREC_CACHE_NORMAL = 4096,
+       CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_ALL = 131071 };
+#define CONTACT_FLAG_BITS 6
 
 /* The friction basis the solver starts from for a normal (solver.c): the
  * kept basis of a resting contact is usually this, to the last bits. */
@@ -1160,9 +1182,12 @@ static unsigned contact_bits(const contact *c, const contact_data *d, const cont
 {
     contact_guess g = *gp;
     int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
+    vec3 basis = basis_guess(c->cache.normal);
+    int tangent_guessed = !v3_is_zero(d->tangent1) && same_bits(&d->tangent1, &basis, sizeof basis);
     return (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
                         (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
-                        (v3_is_zero(d->tangent1) ? 0 : CREC_TANGENT) | (v3_is_zero(normal) ? 0 : CREC_NORMAL) |
+                        (v3_is_zero(d->tangent1) ? 0 : tangent_guessed ? CREC_TANGENT_GUESS : CREC_TANGENT) |
+                        (v3_is_zero(normal) || d->m.count > 0 ? 0 : CREC_NORMAL) | /* (a manifold with points: always written) */
                         (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
                         (!c->slot || (f64_bits(d->friction) == f64_bits(g.material[0]) && f64_bits(d->restitution) == f64_bits(g.material[1]) &&
                                     f64_bits(d->rolling_resistance) == f64_bits(g.material[2]))
@@ -1212,14 +1237,13 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
         put_varint(o, zigzag((int64_t)c->id_a - last_a));
         put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
         last_a = c->id_a;
-        put_u8(o, c->flags);
-        put_varint(o, bits);
+        put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
         if (bits & CREC_SUB) put_varint(o, c->sub);
         if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
         if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
         acct(o, SNAP_FIELD_contact_header, at);
         at = o->pos;
-        if (bits & CREC_NORMAL) put_coded_v3(o, normal, v3(0, 0, 0));
+        if (d->m.count > 0 || (bits & CREC_NORMAL)) put_coded_v3(o, normal, v3(0, 0, 0));
         acct(o, SNAP_FIELD_contact_normal, at);
         at = o->pos;
         if (bits & CREC_CACHE_NORMAL) put_coded_v3(o, c->cache.normal, cache_guess);
@@ -1262,7 +1286,7 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
             double cur[7] = {st->local_a.x, st->local_a.y, st->local_a.z, st->separation,
                              st->normal_impulse, st->tangent_impulse[0], st->tangent_impulse[1]};
             at = o->pos;
-            put_varint(o, p->id);
+            put_varint(o, p->id ^ (k ? d->m.points[k - 1].id : 0)); /* (a manifold's ids share their high bits) */
             acct(o, SNAP_FIELD_point_id, at);
             at = o->pos;
             put_coded(o, cur, last, 3);
@@ -1646,7 +1670,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         s->angular_velocity[i] = (bits & REC_SPIN) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
         s->force[i] = (bits & REC_FORCE) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
         s->torque[i] = (bits & REC_TORQUE) ? get_coded_v3(r, v3(0, 0, 0), what) : v3(0, 0, 0);
-        s->sleep_time[i] = (bits & REC_SLEEP_TIME) ? (last_sleep = get_coded1(r, last_sleep, what)) : 0.0;
+        s->sleep_time[i] = (bits & REC_SLEEP_TIME) ? (last_sleep = get_coded1(r, last_sleep, what)) : sleep_guess(s, i, w->def.sleep_time);
         s->plane_offset[i] = (k->flags & BODY_LOCK_PLANE) ? get_coded1(r, v3_dot(k->plane_normal, s->center[i]), what) : 0.0;
         if (r->failed) break;
         if (!within_cube(s->center[i], RANGE_STATE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e18 m", i); break; }
@@ -1678,7 +1702,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
             bad(r, "body %d previous orientation is not unit", i);
             break;
         }
-        xform p = previous_pose(s, i);
+        xform p = collided_guess(s, i, x);
         s->collided[i].p = (bits & REC_COLLIDED) ? get_coded_v3(r, p.p, what) : p.p;
         s->collided[i].q = (bits & REC_COLLIDED) ? get_coded_q(r, p.q, what) : p.q;
         if (r->failed) break;
@@ -1699,7 +1723,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         if (!(fat.lo.x <= fat.hi.x && fat.lo.y <= fat.hi.y && fat.lo.z <= fat.hi.z)) { bad(r, "body %d bounds are inverted", i); break; }
         if (!(isfinite(fat.lo.x) && isfinite(fat.lo.y) && isfinite(fat.lo.z) && isfinite(fat.hi.x) && isfinite(fat.hi.y) &&
               isfinite(fat.hi.z))) { bad(r, "body %d bounds are not finite", i); break; }
-        if (body_bits(s, i, x, predicted, s->solver_index[i]) != (unsigned)bits) {
+        if (body_bits(s, i, x, predicted, s->solver_index[i], w->def.sleep_time) != (unsigned)bits) {
             bad(r, "body %d: its record bits do not match its fields (a field equal to its prediction written)", i);
             break;
         }
@@ -1745,7 +1769,7 @@ static int read_contacts(reader *r, carom_world *w, const int *class_of)
     contact_set *cs = &w->contacts;
     int count = get_small(r, 0, 1 << 28, 0, "contact count");
     if (r->failed) return 0;
-    if ((size_t)count * 4 > r->size - r->pos) return bad(r, "truncated: %d contacts need more than the bytes left", count);
+    if ((size_t)count * 3 > r->size - r->pos) return bad(r, "truncated: %d contacts need more than the bytes left", count); /* (the shortest record: 3 bytes) */
     if (!contact_set_reserve(cs, count)) return bad(r, "out of memory");
     mix_memo *memo = malloc(sizeof *memo); /* (without it, every contact mixes its own) */
     if (memo) mix_memo_init(memo, class_of);
@@ -1775,8 +1799,9 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         last_a = a;
         if (s->ids[a].slot < 0 || s->ids[b].slot < 0)
             return bad(r, "contact %d joins ids %d and %d, not two live bodies", i, a, b);
-        uint32_t flags = get_u8(r, "contact flags");
-        int bits = get_small(r, 0, CREC_ALL, 0, "contact bits");
+        int head = get_small(r, 0, ((int64_t)CREC_ALL << CONTACT_FLAG_BITS) | ((1 << CONTACT_FLAG_BITS) - 1), 0, "contact flags");
+        uint32_t flags = (uint32_t)head & ((1u << CONTACT_FLAG_BITS) - 1);
+        int bits = head >> CONTACT_FLAG_BITS;
         uint32_t sub = (bits & CREC_SUB) ? (uint32_t)get_small(r, 1, 1000000, 0, "contact sub") : 0;
         uint32_t sub_limit = (bits & CREC_SUB_LIMIT) ? (uint32_t)get_small(r, 1, 1000001, 0, "contact sub limit") : 0;
         int feature = (bits & CREC_FEATURE) ? get_small(r, 0, INT32_MAX, 1, "contact cache feature") : -1;
@@ -1804,7 +1829,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         c->cache.flip = (bits & CREC_FLIP) != 0;
         c->cache.feature = feature;
         d->m.count = bits & 7;
-        vec3 normal = (bits & CREC_NORMAL) ? get_coded_v3(r, v3(0, 0, 0), "manifold normal") : v3(0, 0, 0);
+        vec3 normal = (d->m.count > 0 || (bits & CREC_NORMAL)) ? get_coded_v3(r, v3(0, 0, 0), "manifold normal") : v3(0, 0, 0);
         d->m.normal = normal;
         if (!r->failed && !v3_is_zero(normal) && !normal_is_state(c, d))
             return bad(r, "contact %d has a normal it does not use", i);
@@ -1815,7 +1840,8 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         d->friction = material[0];
         d->restitution = material[1];
         d->rolling_resistance = material[2];
-        d->tangent1 = (bits & CREC_TANGENT) ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis") : v3(0, 0, 0);
+        d->tangent1 = (bits & CREC_TANGENT)         ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis")
+                      : (bits & CREC_TANGENT_GUESS) ? basis_guess(c->cache.normal) : v3(0, 0, 0);
         /* the predictions, as the writer made them */
         xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
         double reach = (flags & CONTACT_APART) ? body_reach(s, memo, sb) : 0.0;
@@ -1850,7 +1876,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             manifold_point *p = &d->m.points[k];
             contact_point_state *st = &d->state[k];
             double cur[7];
-            p->id = (uint32_t)get_small(r, 0, UINT32_MAX, 0, "manifold point id");
+            p->id = (uint32_t)get_small(r, 0, UINT32_MAX, 0, "manifold point id") ^ (k ? d->m.points[k - 1].id : 0u);
             get_coded(r, cur, last, 3, "contact point");
             get_coded(r, cur + 3, last + 3, 4, "contact point");
             st->local_a = v3(cur[0], cur[1], cur[2]);
