@@ -39,6 +39,8 @@
 /* farther apart than this, a pair's separation is its distance (GJK's
  * proven lower bound); nearer, the contacts the next step will see */
 #define TOI_NEAR 0.01
+/* the look-ahead of a near pair's contacts against a mesh or height field */
+#define TOI_NEAR_REACH (4 * TOI_NEAR)
 
 /* Thickness below which a shape can pass through others in one step. */
 static double min_extent(const shape *s)
@@ -259,9 +261,20 @@ static double separation_at(const toi_context *ctx, int a, int b, double t, doub
     memset(&cache, 0, sizeof cache);
     cache.feature = -1;
     manifold m;
-    collide(&s->shapes[a], xa, &s->shapes[b], xb, range, &cache, &m);
+    /* a mesh or height field: only the triangles within TOI_NEAR_REACH (the
+     * query box grows with the look-ahead; the step's whole reach took in
+     * every triangle a fast body could touch, each clipped and grouped, to
+     * find the one deepest point); none that near: that much room at least,
+     * and the distance test may answer again */
+    double spec = range;
+    int composite = shape_is_composite(&s->shapes[a]) || shape_is_composite(&s->shapes[b]);
+    if (composite && spec > TOI_NEAR_REACH) spec = TOI_NEAR_REACH;
+    collide(&s->shapes[a], xa, &s->shapes[b], xb, spec, &cache, &m);
     *normal = m.normal;
-    if (m.count == 0) return range;
+    if (m.count == 0) {
+        if (spec < range) *try_far = 1;
+        return spec;
+    }
     double d = m.points[0].separation;
     for (int i = 1; i < m.count; i++) d = dmin(d, m.points[i].separation);
     return d;
