@@ -666,8 +666,9 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     work->scalar = NULL;
     work->scalar_count = ctx->constraint_count;
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
+    if (!s->solver.wide_env) s->solver.wide_env = wide_read_env(); /* once per world, not a getenv a step */
     work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count,
-                           work->locked, ctx->body_count);
+                           work->locked, ctx->body_count, s->solver.wide_env);
     if (!work->wide) return 0;
     work->scalar_count = wide_overflow(work->wide, &work->scalar);
     return 1;

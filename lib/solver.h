@@ -19,6 +19,7 @@ typedef struct solver_memory {
     int extra_capacity;
     void *wide;                  /* solver_wide.c's batches */
     size_t wide_capacity;
+    int wide_env;                /* wide_read_env's switches (0: not read yet) */
     void *order;                 /* the manifolds' solve-order keys (sort_touching) */
     int order_capacity;
     int *points;                 /* this step: each touching manifold's point count, in solve order */

@@ -11,7 +11,9 @@
  * whose passes keep the locked velocities in their planes. Manifolds beyond
  * the last colour, or with rolling resistance, keep the scalar passes
  * (contact_solver.c). The AVX2 and SSE2 builds
- * of the passes come from one source (WIDE_PASSES below). */
+ * of the passes come from one source (WIDE_PASSES below), each for two row
+ * layouts: the precomputed rows (wide_point) and, for large worlds, the
+ * compact ones (wide_cpoint), recomputed from the anchors in each pass. */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,8 +52,39 @@ typedef struct wide_point {
     lane_t ra_t[2][3], rb_t[2][3], ia_t[2][3], ib_t[2][3];
 } wide_point;
 
+/* The compact point of a large world's batches (wide_plan: at least
+ * WIDE_COMPACT_POINTS points), 112 bytes a point instead of 352: the
+ * anchors in the batch's contact basis (n, t1, t2) instead of the nine arms
+ * and their nine responses through the inertias. In that basis an arm
+ * r x e is three coordinates of r, and the inertias' responses come from
+ * the batch's two basis-projected inverse inertias (wide_inertia), so every
+ * row is recomputed in each pass, in double, from 14 lanes a point and 12 a
+ * manifold. The same rows as wide_point's, to rounding; the velocities are
+ * solved in the basis too (wide normal and friction rows then read one or
+ * two coordinates), turned into it when a batch is gathered and back when
+ * it is scattered. A small world's rows fit the caches and the precomputed
+ * ones take fewer instructions; a large world's stream from memory in every
+ * pass, and there the bytes cost more than the arithmetic. */
+typedef struct wide_cpoint {
+    lane_t base_separation, normal_mass, normal_impulse;
+    lane_t total_normal_impulse;
+    lane_t tangent_mass[2], tangent_impulse[2];
+    lane_t ra[3], rb[3];         /* anchors from each centre, in the basis: (r.n, r.t1, r.t2) */
+} wide_cpoint;
+
+/* A compact batch's inverse inertias in its basis e = (n, t1, t2), e_i.I^-1 e_j:
+ * the upper triangle 00 01 02 11 12 22. */
+typedef struct wide_inertia {
+    lane_t ka[6], kb[6];
+} wide_inertia;
+
+/* Points from here on a batch take the compact rows (wide_cpoint): 16,384
+ * points of wide_point are 5.8 MB, past a core's share of the last-level
+ * cache of the machines this was measured on. */
+#define WIDE_COMPACT_POINTS 16384
+
 /* A locked batch's plane normals per lane (zero: a free body), solver.c's
- * constraint_extra lock_a and lock_b. */
+ * constraint_extra lock_a and lock_b; a compact batch's in its basis. */
 typedef struct wide_lock {
     lane_t a[3], b[3];
 } wide_lock;
@@ -71,6 +104,9 @@ typedef struct wide_batch {
 struct wide_set {
     wide_batch *batches;
     wide_point *points;
+    wide_cpoint *cpoints;        /* the same block, compact: one or the other is used */
+    wide_inertia *inertia;       /* compact: per batch */
+    int compact;                 /* the batches take the compact rows */
     wide_lock *locks;            /* locked batches' plane normals */
     int *overflow;               /* constraints with no colour: scalar passes */
     double *deepest;             /* per batch: its deepest overlap (prepare) */
@@ -93,6 +129,11 @@ typedef struct wide_passes {
                          int last);
 } wide_passes;
 
+/* Both row layouts' builds of the passes. */
+typedef struct wide_kernels {
+    wide_passes full, compact;
+} wide_kernels;
+
 static size_t align_up(size_t n) { return (n + 63) & ~(size_t)63; }
 
 /* A lane's batch header: the manifold's bodies, basis and material. */
@@ -109,6 +150,10 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
     if (wb->lock >= 0) {
         wide_lock *lk = &ws->locks[wb->lock];
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
+        if (ws->compact) { /* in the basis */
+            la = v3(v3_dot(la, c->n), v3_dot(la, c->t1), v3_dot(la, c->t2));
+            lb = v3(v3_dot(lb, c->n), v3_dot(lb, c->t1), v3_dot(lb, c->t2));
+        }
         for (int d = 0; d < 3; d++) {
             lk->a[d][l] = v3_get(la, d);
             lk->b[d][l] = v3_get(lb, d);
@@ -132,18 +177,19 @@ typedef struct plan_buckets {
 
 /* The set, its batches and points and the planner's scratch in one block
  * (grown, never shrunk), 64-byte aligned. */
-static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constraint *cc, int ncon, int nlocked,
+static wide_set *reserve_set(void **mem, size_t *capacity, int npoints, int compact, int ncon, int nlocked,
                              int nb, int **color, uint32_t **used)
 {
     /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
-    int npoints = 0;
-    for (int k = 0; k < ncon; k++) npoints += cc[k].count;
+    size_t point_size = compact ? sizeof(wide_cpoint) : sizeof(wide_point);
     int buckets = nlocked ? 2 : 1; /* locked manifolds have buckets of their own */
     int max_batches = ncon / LANES + buckets * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
     int max_locks = nlocked ? nlocked / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
     int max_wide_points = npoints / LANES + buckets * WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
+    size_t inertia_bytes = compact ? align_up(sizeof(wide_inertia) * (size_t)max_batches) : 0;
     size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
-                   align_up(sizeof(wide_point) * (size_t)max_wide_points) + align_up(sizeof(wide_lock) * (size_t)max_locks) +
+                   align_up(point_size * (size_t)max_wide_points) + align_up(sizeof(wide_lock) * (size_t)max_locks) +
+                   inertia_bytes +
                    align_up(sizeof(int) * (size_t)ncon) * 2 +
                    align_up(sizeof(uint32_t) * (size_t)nb) + align_up(sizeof(double) * (size_t)max_batches);
     if (bytes > *capacity) {
@@ -157,11 +203,15 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const contact_constra
     char *base = (char *)(((uintptr_t)*mem + 63) & ~(uintptr_t)63);
     wide_set *ws = (wide_set *)base;
     ws->lock_kinds = buckets;
+    ws->compact = compact;
     base += align_up(sizeof *ws);
     ws->batches = (wide_batch *)base;
     base += align_up(sizeof(wide_batch) * (size_t)max_batches);
     ws->points = (wide_point *)base;
-    base += align_up(sizeof(wide_point) * (size_t)max_wide_points);
+    ws->cpoints = (wide_cpoint *)base;
+    base += align_up(point_size * (size_t)max_wide_points);
+    ws->inertia = compact ? (wide_inertia *)base : NULL;
+    base += inertia_bytes;
     ws->locks = (wide_lock *)base;
     base += align_up(sizeof(wide_lock) * (size_t)max_locks);
     ws->overflow = (int *)base;
@@ -218,7 +268,12 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb)
                     if (i == batches - 1 && pb->count[bk] % LANES) {
                         /* the part-full batch: empty lanes stay zero (no mass, no effect) */
                         memset(wb, 0, sizeof *wb);
-                        memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
+                        if (ws->compact) {
+                            memset(&ws->cpoints[first], 0, sizeof(wide_cpoint) * (size_t)n);
+                            memset(&ws->inertia[nbatch + i], 0, sizeof(wide_inertia));
+                        } else {
+                            memset(&ws->points[first], 0, sizeof(wide_point) * (size_t)n);
+                        }
                     }
                     wb->count = n;
                     wb->first = first;
@@ -254,11 +309,22 @@ static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int
     }
 }
 
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb)
+int wide_read_env(void)
+{
+    const char *layout = getenv("CAROM_WIDE_COMPACT");
+    int env = WIDE_ENV_READ | (getenv("CAROM_NO_AVX2") ? WIDE_ENV_NO_AVX2 : 0);
+    if (layout && *layout) env |= *layout != '0' ? WIDE_ENV_COMPACT : WIDE_ENV_FULL;
+    return env;
+}
+
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb, int env)
 {
     int *color;
     uint32_t *used;
-    wide_set *ws = reserve_set(mem, capacity, cc, ncon, nlocked, nb, &color, &used);
+    int npoints = 0;
+    for (int k = 0; k < ncon; k++) npoints += cc[k].count;
+    int compact = env & WIDE_ENV_COMPACT ? 1 : env & WIDE_ENV_FULL ? 0 : npoints >= WIDE_COMPACT_POINTS;
+    wide_set *ws = reserve_set(mem, capacity, npoints, compact, ncon, nlocked, nb, &color, &used);
     if (!ws) return NULL;
     plan_buckets pb;
     color_manifolds(ws, cc, ncon, color, used, &pb);
@@ -266,8 +332,9 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
     fill_lanes(ws, cc, ncon, color, &pb);
 #if WIDE_AVX2
     /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
-    ws->avx2 = __builtin_cpu_supports("avx2") != 0 && !getenv("CAROM_NO_AVX2");
+    ws->avx2 = __builtin_cpu_supports("avx2") != 0 && !(env & WIDE_ENV_NO_AVX2);
 #else
+    (void)env;
     ws->avx2 = 0;
 #endif
     return ws;
@@ -695,6 +762,318 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     return deepest;
 }
 
+/* ---- the compact rows (wide_cpoint) --------------------------------------
+ * The same rows as above with every arm in the batch's basis e = (n, t1,
+ * t2): an anchor r = (r0, r1, r2) there has the arms r x n = (0, r2, -r1),
+ * r x t1 = (-r2, 0, r0) and r x t2 = (r1, -r0, 0), and a body's velocities
+ * in the basis meet the normal row in their first coordinate and the
+ * friction rows in the other two. */
+
+/* K x for the upper triangle K of a symmetric matrix (wide_inertia). */
+#define SYM_MUL(u, K, x)                                              \
+    do {                                                              \
+        (u)[0] = (K)[0] * (x)[0] + (K)[1] * (x)[1] + (K)[2] * (x)[2]; \
+        (u)[1] = (K)[1] * (x)[0] + (K)[3] * (x)[1] + (K)[4] * (x)[2]; \
+        (u)[2] = (K)[2] * (x)[0] + (K)[4] * (x)[1] + (K)[5] * (x)[2]; \
+    } while (0)
+/* a world vector's coordinates in the batch's basis */
+#define TO_BASIS(dst, wb_, src)                 \
+    do {                                        \
+        (dst)[0] = DOT3((wb_)->n, src);         \
+        (dst)[1] = DOT3((wb_)->t1, src);        \
+        (dst)[2] = DOT3((wb_)->t2, src);        \
+    } while (0)
+
+/* The lanes' bodies as gathered (world) and in the basis, solved there. */
+typedef struct lane_cbodies {
+    lane_bodies world;
+    lane_t va[3], wa[3], vb[3], wb[3];         /* solved */
+    lane_t va0[3], wa0[3], vb0[3], wb0[3];     /* as gathered */
+    lane_t ma, mb;
+} lane_cbodies;
+
+LANE_INLINE void gather_c(const wide_batch *wb, const impulse_body *bodies, lane_cbodies *lb)
+{
+    gather(wb, bodies, &lb->world);
+    TO_BASIS(lb->va0, wb, lb->world.va);
+    TO_BASIS(lb->wa0, wb, lb->world.wa);
+    TO_BASIS(lb->vb0, wb, lb->world.vb);
+    TO_BASIS(lb->wb0, wb, lb->world.wb);
+    for (int d = 0; d < 3; d++) {
+        lb->va[d] = lb->va0[d];
+        lb->wa[d] = lb->wa0[d];
+        lb->vb[d] = lb->vb0[d];
+        lb->wb[d] = lb->wb0[d];
+    }
+    lb->ma = lb->world.ma;
+    lb->mb = lb->world.mb;
+}
+
+/* world += the change made in the basis (a body no row pushed keeps its bits) */
+#define ADD_FROM_BASIS(w_, wb_, now, was)                                                  \
+    do {                                                                                   \
+        lane_t c0_ = (now)[0] - (was)[0], c1_ = (now)[1] - (was)[1], c2_ = (now)[2] - (was)[2]; \
+        for (int k_ = 0; k_ < 3; k_++)                                                     \
+            (w_)[k_] = (w_)[k_] + (c0_ * (wb_)->n[k_] + c1_ * (wb_)->t1[k_] + c2_ * (wb_)->t2[k_]); \
+    } while (0)
+
+LANE_INLINE void scatter_c(const wide_batch *wb, impulse_body *bodies, lane_cbodies *lb)
+{
+    ADD_FROM_BASIS(lb->world.va, wb, lb->va, lb->va0);
+    ADD_FROM_BASIS(lb->world.wa, wb, lb->wa, lb->wa0);
+    ADD_FROM_BASIS(lb->world.vb, wb, lb->vb, lb->vb0);
+    ADD_FROM_BASIS(lb->world.wb, wb, lb->wb, lb->wb0);
+    scatter(wb, bodies, &lb->world);
+}
+
+/* A body's angular change -K (r x P) (a) or +K (r x P) (b), P = (p0, p1, p2) in the basis. */
+#define PUSH_ANGULAR(w_, sign, K, r, p0, p1, p2)                                                         \
+    do {                                                                                                \
+        lane_t x_[3] = {(r)[1] * (p2) - (r)[2] * (p1), (r)[2] * (p0) - (r)[0] * (p2), (r)[0] * (p1) - (r)[1] * (p0)}; \
+        lane_t u_[3];                                                                                   \
+        SYM_MUL(u_, K, x_);                                                                             \
+        for (int k_ = 0; k_ < 3; k_++) (w_)[k_] = (w_)[k_] sign u_[k_];                                  \
+    } while (0)
+
+LANE_INLINE void warm_batch_c(const wide_batch *wb, const wide_inertia *in, wide_cpoint *pts, impulse_body *bodies,
+                              const wide_lock *lk, const int locked)
+{
+    lane_cbodies lb;
+    const lane_t zero = SPLAT(0.0);
+    gather_c(wb, bodies, &lb);
+    for (int i = 0; i < wb->count; i++) {
+        wide_cpoint *p = &pts[i];
+        lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
+        p->total_normal_impulse += ni;
+        lb.va[0] -= lb.ma * ni;
+        lb.va[1] -= lb.ma * t1;
+        lb.va[2] -= lb.ma * t2;
+        lb.vb[0] += lb.mb * ni;
+        lb.vb[1] += lb.mb * t1;
+        lb.vb[2] += lb.mb * t2;
+        PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, t1, t2);
+        PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, t1, t2);
+        if (locked) {
+            KEEP_IN_PLANE(lb.va, lk->a);
+            KEEP_IN_PLANE(lb.vb, lk->b);
+        }
+    }
+    (void)zero;
+    scatter_c(wb, bodies, &lb);
+}
+
+LANE_INLINE void solve_normal_rows_c(const wide_batch *wb, const wide_inertia *in, wide_cpoint *pts,
+                                     const step_context *ctx, lane_cbodies *lb, int use_bias, int hold_bounces,
+                                     const wide_lock *lk, const int locked)
+{
+    lane_t dp[3], dqa[3], dqb[3];
+    gather_motion(wb, ctx, dp, dqa, dqb);
+    /* the motion in the basis: what the separations read of it */
+    lane_t dpn = DOT3(wb->n, dp), qa1 = DOT3(wb->t1, dqa), qa2 = DOT3(wb->t2, dqa), qb1 = DOT3(wb->t1, dqb),
+           qb2 = DOT3(wb->t2, dqb);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(ctx->inv_h), push = SPLAT(-ctx->push_max);
+    lane_t pen_mass_scale = one, pen_impulse_scale = zero;
+    int soft = use_bias && ctx->correction == CAROM_CORRECTION_SOFT;
+    int baumgarte = use_bias && ctx->correction == CAROM_CORRECTION_BAUMGARTE;
+    if (soft) {
+        pen_mass_scale = wb->mass_scale;
+        pen_impulse_scale = wb->impulse_scale;
+    }
+    const lane_t baum_rate = SPLAT(ctx->baumgarte_rate), slop = SPLAT(ctx->slop);
+    for (int i = 0; i < wb->count; i++) {
+        wide_cpoint *p = &pts[i];
+        const lane_t *a = p->ra, *b = p->rb;
+        lane_t s = p->base_separation + dpn + (b[2] * qb1 - b[1] * qb2) - (a[2] * qa1 - a[1] * qa2);
+        lane_t pen_bias = zero;
+        if (soft || baumgarte) {
+            lane_t rate = wb->bias_rate;
+            pen_bias = CONTACT_PUSH_BIAS(soft, s, rate, baum_rate, slop, push, zero, LANE_MAX, LANE_MIN);
+        }
+        lane_mask ahead = s > zero;
+        lane_t spec = CONTACT_SPECULATIVE_BIAS(s, inv_h);
+        lane_t bias = SELECT_LANES(ahead, spec, pen_bias);
+        lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
+        lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
+        lane_t vn = (lb->vb[0] - lb->va[0]) + (b[2] * lb->wb[1] - b[1] * lb->wb[2]) -
+                    (a[2] * lb->wa[1] - a[1] * lb->wa[2]);
+        lane_t old = p->normal_impulse;
+        lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
+        total = LANE_MAX(total, zero);
+        if (hold_bounces) {
+            lane_mask hold = ahead & (wb->restitution > zero);
+            total = SELECT_LANES(hold, LANE_MIN(total, old), total);
+        }
+        lane_t lambda = total - old;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        lb->va[0] -= lb->ma * lambda;
+        lb->vb[0] += lb->mb * lambda;
+        PUSH_ANGULAR(lb->wa, -, in->ka, a, lambda, zero, zero);
+        PUSH_ANGULAR(lb->wb, +, in->kb, b, lambda, zero, zero);
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
+    }
+}
+
+LANE_INLINE void solve_friction_rows_c(const wide_batch *wb, const wide_inertia *in, wide_cpoint *pts,
+                                       lane_cbodies *lb, const wide_lock *lk, const int locked)
+{
+    const lane_t zero = SPLAT(0.0);
+    for (int i = 0; i < wb->count; i++) {
+        wide_cpoint *p = &pts[i];
+        const lane_t *a = p->ra, *b = p->rb;
+        lane_t v1 = (lb->vb[1] - lb->va[1]) + (b[0] * lb->wb[2] - b[2] * lb->wb[0]) -
+                    (a[0] * lb->wa[2] - a[2] * lb->wa[0]);
+        lane_t v2 = (lb->vb[2] - lb->va[2]) + (b[1] * lb->wb[0] - b[0] * lb->wb[1]) -
+                    (a[1] * lb->wa[0] - a[0] * lb->wa[1]);
+        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
+        lane_t limit = wb->friction * p->normal_impulse;
+        lane_t mag2 = n1 * n1 + n2 * n2;
+        lane_mask over = mag2 > limit * limit;
+        if (over[0] | over[1] | over[2] | over[3]) {
+            for (int l = 0; l < LANES; l++) {
+                if (!over[l]) continue;
+                double s1 = n1[l], s2 = n2[l];
+                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
+                                  limit[l]);
+                n1[l] = s1;
+                n2[l] = s2;
+            }
+        }
+        p->tangent_impulse[0] = n1;
+        p->tangent_impulse[1] = n2;
+        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        lb->va[1] -= lb->ma * d1;
+        lb->va[2] -= lb->ma * d2;
+        lb->vb[1] += lb->mb * d1;
+        lb->vb[2] += lb->mb * d2;
+        PUSH_ANGULAR(lb->wa, -, in->ka, a, zero, d1, d2);
+        PUSH_ANGULAR(lb->wb, +, in->kb, b, zero, d1, d2);
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
+    }
+}
+
+LANE_INLINE void solve_batch_c(const wide_batch *wb, const wide_inertia *in, wide_cpoint *pts,
+                               const step_context *ctx, int use_bias, int hold_bounces, const wide_lock *lk,
+                               const int locked)
+{
+    lane_cbodies lb;
+    gather_c(wb, ctx->bodies, &lb);
+    solve_normal_rows_c(wb, in, pts, ctx, &lb, use_bias, hold_bounces, lk, locked);
+    if (ctx->friction) solve_friction_rows_c(wb, in, pts, &lb, lk, locked);
+    scatter_c(wb, ctx->bodies, &lb);
+}
+
+/* out += r.(K r) for an arm r */
+#define ADD_QUAD(out, K, x)          \
+    do {                             \
+        lane_t u_[3];                \
+        SYM_MUL(u_, K, x);           \
+        (out) = (out) + DOT3(x, u_); \
+    } while (0)
+
+/* The basis-projected inverse inertia of one side's lanes. */
+LANE_INLINE void project_inertia(lane_t k[6], const wide_batch *wb, lane_t ia[3][3])
+{
+    lane_t in_[3], it1[3], it2[3];
+    MAT_VEC(in_, ia, wb->n);
+    MAT_VEC(it1, ia, wb->t1);
+    MAT_VEC(it2, ia, wb->t2);
+    k[0] = DOT3(wb->n, in_);
+    k[1] = DOT3(wb->n, it1);
+    k[2] = DOT3(wb->n, it2);
+    k[3] = DOT3(wb->t1, it1);
+    k[4] = DOT3(wb->t1, it2);
+    k[5] = DOT3(wb->t2, it2);
+}
+
+LANE_INLINE void warm_cpoint(wide_cpoint *p, const contact_point_state *const st[LANES], double warm)
+{
+    const lane_t zero = SPLAT(0.0), warm_scale = SPLAT(warm);
+    lane_t ni, t1, t2;
+    SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
+    SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
+    SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
+    p->normal_impulse = warm_scale * ni;
+    p->tangent_impulse[0] = warm_scale * t1;
+    p->tangent_impulse[1] = warm_scale * t2;
+    p->total_normal_impulse = zero;
+}
+
+/* The effective mass 1 / k of a row, 0 where k is not positive. */
+#define ROW_MASS(k) SELECT_LANES((k) > zero, one / SELECT_LANES((k) > zero, (k), one), zero)
+
+LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_cpoint *pts, contact_constraint *cc,
+                                   const impulse_body *bodies, double warm, const wide_lock *lk)
+{
+    static const manifold_point no_point = {{0, 0, 0}, 0, 0};
+    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
+    lane_manifolds lm;
+    gather_manifolds(wb, cc, bodies, &lm);
+    project_inertia(in->ka, wb, lm.ia);
+    project_inertia(in->kb, wb, lm.ib);
+    /* the linear share of each row's inverse effective mass (n, t1, t2);
+     * a locked body's plane normal is in the basis here */
+    lane_t lin[3];
+    lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
+    if (lk) {
+        for (int d = 0; d < 3; d++)
+            lin[d] = lm.ma * (one - lk->a[d] * lk->a[d]) + lm.mb * (one - lk->b[d] * lk->b[d]);
+    }
+    double deepest = 0.0;
+    for (int i = 0; i < wb->count; i++) {
+        wide_cpoint *p = &pts[i];
+        const manifold_point *mp[LANES];
+        const contact_point_state *st[LANES];
+        for (int l = 0; l < LANES; l++) {
+            mp[l] = lm.c[l] ? &lm.c[l]->m->points[i] : &no_point;
+            st[l] = lm.c[l] ? &lm.c[l]->warm[i] : &no_state;
+        }
+        lane_t point[3], sep;
+        gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
+        SET_LANES(sep, mp[0], mp[1], mp[2], mp[3], separation);
+        lane_t ra[3], rb[3];
+        for (int d = 0; d < 3; d++) {
+            ra[d] = point[d] - lm.center_a[d];
+            rb[d] = point[d] - lm.center_b[d];
+        }
+        TO_BASIS(p->ra, wb, ra);
+        TO_BASIS(p->rb, wb, rb);
+        const lane_t *a = p->ra, *b = p->rb;
+        /* the arms r x n, r x t1, r x t2 in the basis, and their masses */
+        lane_t jan[3] = {zero, a[2], -a[1]}, jbn[3] = {zero, b[2], -b[1]};
+        lane_t ja1[3] = {-a[2], zero, a[0]}, jb1[3] = {-b[2], zero, b[0]};
+        lane_t ja2[3] = {a[1], -a[0], zero}, jb2[3] = {b[1], -b[0], zero};
+        lane_t kn = lin[0], k1 = lin[1], k2 = lin[2];
+        ADD_QUAD(kn, in->ka, jan);
+        ADD_QUAD(kn, in->kb, jbn);
+        ADD_QUAD(k1, in->ka, ja1);
+        ADD_QUAD(k1, in->kb, jb1);
+        ADD_QUAD(k2, in->ka, ja2);
+        ADD_QUAD(k2, in->kb, jb2);
+        p->normal_mass = ROW_MASS(kn);
+        p->tangent_mass[0] = ROW_MASS(k1);
+        p->tangent_mass[1] = ROW_MASS(k2);
+        p->base_separation = sep;
+        lane_t wxa[3], wxb[3];
+        CROSS(wxa, lm.wa, ra);
+        CROSS(wxb, lm.wb, rb);
+        lane_t vrel[3];
+        for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
+        lane_t vn = DOT3(vrel, wb->n);
+        warm_cpoint(p, st, warm);
+        deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
+    }
+    return deepest;
+}
+
 /* The passes over every batch, written once and built twice: for the base
  * target (SSE2 on x86-64) and, chosen at run time, for AVX2 (one register per
  * four lanes instead of two, and twice the registers). No FMA: rounding stays
@@ -742,8 +1121,52 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
             solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces, NULL, 0);               \
         }                                                                                                \
     }                                                                                                    \
-    static const wide_passes passes##SUFFIX = {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX, \
-                                               warm_locked##SUFFIX, solve_locked##SUFFIX};
+    TARGET static void prepare_batches_c##SUFFIX(const wide_set *ws, contact_constraint *cc,             \
+                                                 const impulse_body *bodies, double warm, int first, int last) \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
+            ws->deepest[k] = prepare_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], cc, bodies, warm, lk); \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void warm_locked_c##SUFFIX(const wide_set *ws, impulse_body *bodies, \
+                                                                      int first, int last)               \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, &ws->locks[wb->lock], 1); \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET static void warm_batches_c##SUFFIX(const wide_set *ws, impulse_body *bodies, int first, int last) \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0);                 \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void solve_locked_c##SUFFIX(const wide_set *ws, const step_context *ctx, \
+                                                                       int use_bias, int hold_bounces, int first, \
+                                                                       int last)                         \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], ctx, use_bias, hold_bounces,     \
+                          &ws->locks[wb->lock], 1);                                                      \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET static void solve_batches_c##SUFFIX(const wide_set *ws, const step_context *ctx, int use_bias, \
+                                               int hold_bounces, int first, int last)                    \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], ctx, use_bias, hold_bounces, NULL, 0); \
+        }                                                                                                \
+    }                                                                                                    \
+    static const wide_kernels passes##SUFFIX = {                                                         \
+        {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX, warm_locked##SUFFIX, solve_locked##SUFFIX}, \
+        {prepare_batches_c##SUFFIX, warm_batches_c##SUFFIX, solve_batches_c##SUFFIX, warm_locked_c##SUFFIX, \
+         solve_locked_c##SUFFIX}};
 
 WIDE_PASSES(_base, )
 #if WIDE_AVX2
@@ -751,14 +1174,14 @@ WIDE_PASSES(_avx2, __attribute__((target("avx2"))))
 #endif
 
 
-/* The build of the passes this set runs. */
+/* The build of the passes this set runs, for its row layout. */
 static const wide_passes *passes_for(const wide_set *ws)
 {
+    const wide_kernels *k = &passes_base;
 #if WIDE_AVX2
-    if (ws->avx2) return &passes_avx2;
+    if (ws->avx2) k = &passes_avx2;
 #endif
-    (void)ws;
-    return &passes_base;
+    return ws->compact ? &k->compact : &k->full;
 }
 
 /* Batches per range handed to the task hooks: a range of a solve pass is a
@@ -860,6 +1283,15 @@ void wide_read_impulses(const wide_set *ws, contact_constraint *c)
 {
     const wide_batch *wb = &ws->batches[c->wide_batch];
     int l = c->wide_lane;
+    if (ws->compact) {
+        for (int i = 0; i < c->count; i++) {
+            const wide_cpoint *q = &ws->cpoints[wb->first + i];
+            c->p[i].normal_impulse = q->normal_impulse[l];
+            c->p[i].tangent_impulse[0] = q->tangent_impulse[0][l];
+            c->p[i].tangent_impulse[1] = q->tangent_impulse[1][l];
+        }
+        return;
+    }
     for (int i = 0; i < c->count; i++) {
         const wide_point *q = &ws->points[wb->first + i];
         c->p[i].normal_impulse = q->normal_impulse[l];
@@ -868,20 +1300,30 @@ void wide_read_impulses(const wide_set *ws, contact_constraint *c)
     }
 }
 
+/* The loop over either layout's points (one branch a call, not a lane). */
+#define STORE_POINTS(PTS)                                                                          \
+    for (int k = 0; k < ws->batch_count; k++) {                                                    \
+        const wide_batch *wb = &ws->batches[k];                                                    \
+        for (int l = 0; l < wb->lanes; l++) {                                                      \
+            contact_constraint *c = &cc[wb->con[l]];                                               \
+            for (int i = 0; i < wb->count; i++) {                                                  \
+                const PTS *q = &PTS##_array[wb->first + i];                                       \
+                constraint_point *p = &c->p[i];                                                    \
+                p->normal_impulse = q->normal_impulse[l];                                          \
+                p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */ \
+                p->tangent_impulse[0] = q->tangent_impulse[0][l];                                  \
+                p->tangent_impulse[1] = q->tangent_impulse[1][l];                                  \
+            }                                                                                      \
+        }                                                                                          \
+    }
+
 void wide_store(const wide_set *ws, contact_constraint *cc)
 {
-    for (int k = 0; k < ws->batch_count; k++) {
-        const wide_batch *wb = &ws->batches[k];
-        for (int l = 0; l < wb->lanes; l++) {
-            contact_constraint *c = &cc[wb->con[l]];
-            for (int i = 0; i < wb->count; i++) {
-                const wide_point *q = &ws->points[wb->first + i];
-                constraint_point *p = &c->p[i];
-                p->normal_impulse = q->normal_impulse[l];
-                p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */
-                p->tangent_impulse[0] = q->tangent_impulse[0][l];
-                p->tangent_impulse[1] = q->tangent_impulse[1][l];
-            }
-        }
+    if (ws->compact) {
+        const wide_cpoint *wide_cpoint_array = ws->cpoints;
+        STORE_POINTS(wide_cpoint)
+    } else {
+        const wide_point *wide_point_array = ws->points;
+        STORE_POINTS(wide_point)
     }
 }

@@ -8,11 +8,17 @@
 #include "constraint.h"
 
 typedef struct wide_set wide_set;
+/* The test switches the wide passes read from the environment, once per
+ * world (wide_read_env): the SSE2 build over AVX2 (CAROM_NO_AVX2), a row
+ * layout forced (CAROM_WIDE_COMPACT=0 or 1; tests compare them). */
+enum { WIDE_ENV_READ = 1, WIDE_ENV_NO_AVX2 = 2, WIDE_ENV_FULL = 4, WIDE_ENV_COMPACT = 8 };
+int wide_read_env(void);
 /* Colours the constraints and lays out the batches in *mem (grown as
  * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
  * and filling the batch headers; nlocked: how many constraints have a
- * plane-locked body (they get batches of their own). NULL on out of memory. */
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb);
+ * plane-locked body (they get batches of their own); env: wide_read_env's.
+ * NULL on out of memory. */
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb, int env);
 /* The constraints left to the scalar passes, in order. */
 int wide_overflow(const wide_set *ws, const int **list);
 /* Prepares every batched manifold's points four lanes at a time, as

@@ -760,6 +760,108 @@ static void test_mass_ratio_holds_in_a_wide_step(void **state)
     carom_world_destroy(w);
 }
 
+/* The compact rows large worlds take (solver_wide.c, wide_cpoint: anchors
+ * in the contact basis, every arm recomputed in each pass) are the same
+ * rows: every wide comparison above, with them forced (CAROM_WIDE_COMPACT),
+ * holds as it does for the precomputed rows (the 1-point rows match the
+ * scalar passes to 1e-9, the sliding boxes stop at v^2 / (2 mu g)), and
+ * their AVX2 and SSE2 builds agree bit for bit. A 20-row pyramid is chaotic
+ * at the millimetre: scaling gravity by 1 + 1e-15 moves its boxes as far
+ * from the unperturbed run as the compact rows do (1.8 and 1.6 mm after 20
+ * steps, 5.7 and 5.4 mm after 240), so it is held to standing: no box more
+ * than 2 cm from its start after 120 steps, with either row layout. */
+static void test_compact_rows_match(void **state)
+{
+    for (int compact = 0; compact < 2; compact++) {
+        setenv("CAROM_WIDE_COMPACT", compact ? "1" : "0", 1);
+        carom_world_def wd = carom_world_def_default();
+        wd.enable_sleep = 0;
+        carom_world *w = world_with(wd, 1, 0.6, 0.0);
+        carom_body_id ids[210];
+        carom_vec3 start[210];
+        int n = 0;
+        for (int row = 0; row < 20; row++)
+            for (int i = 0; i < 20 - row; i++) {
+                start[n] = vec((i - (19 - row) * 0.5) * 1.0, 0, 0.5 + row * 1.0);
+                ids[n] = add_box(w, start[n].x, start[n].y, start[n].z, 0.5, 1.0, 0.6);
+                n++;
+            }
+        step_n(w, 120, DT);
+        double worst = 0.0;
+        for (int i = 0; i < n; i++) {
+            carom_vec3 p = pos(w, ids[i]);
+            worst = fmax(worst, sqrt((p.x - start[i].x) * (p.x - start[i].x) + (p.y - start[i].y) * (p.y - start[i].y) +
+                                     (p.z - start[i].z) * (p.z - start[i].z)));
+        }
+        EXPECT_NEAR(worst, 0.0, 0.02, compact ? "pyramid on compact rows, worst box" : "pyramid, worst box");
+        carom_world_destroy(w);
+    }
+    /* a row of tilted, spinning boxes landing on a corner or an edge each
+     * (independent, as in run_row): the rows' arms turn with the boxes, and
+     * the two layouts agree to rounding; the ground is made first (it is
+     * each manifold's body a) or last (body b) */
+    for (int ground_last = 0; ground_last < 2; ground_last++) {
+    carom_vec3 land[2][96];
+    carom_quat turn[2][96];
+    for (int compact = 0; compact < 2; compact++) {
+        setenv("CAROM_WIDE_COMPACT", compact ? "1" : "0", 1);
+        carom_world_def wd = carom_world_def_default();
+        wd.enable_sleep = 0;
+        carom_world *w = world_with(wd, !ground_last, 0.5, 0.0);
+        carom_body_id ids[96];
+        for (int i = 0; i < 96; i++) {
+            carom_body_def d = carom_body_def_default();
+            d.position = vec(4.0 * (i % 12), 4.0 * (i / 12), 1.2);
+            double ax = 0.3 + 0.01 * (i % 7), ay = 0.2 + 0.01 * (i % 5); /* half-angles */
+            carom_quat qx = {cos(ax), sin(ax), 0, 0}, qy = {cos(ay), 0, sin(ay), 0};
+            d.orientation = (carom_quat){qx.w * qy.w, qx.x * qy.w, qx.w * qy.y, qx.x * qy.y};
+            d.angular_velocity = vec(0.5, -1.0, 2.0);
+            d.linear_velocity = vec(1.0, 0, 0);
+            d.shape = carom_shape_box(0.5, 0.3, 0.2);
+            d.friction = 0.5;
+            ids[i] = carom_body_create(w, &d);
+            assert_false(carom_body_id_is_null(ids[i]));
+        }
+        if (ground_last) {
+            carom_body_def g = carom_body_def_default();
+            g.type = CAROM_BODY_STATIC;
+            g.shape = carom_shape_plane(0, 0, 1, 0);
+            g.friction = 0.5;
+            assert_false(carom_body_id_is_null(carom_body_create(w, &g)));
+        }
+        int most = 0;
+        for (int s = 0; s < 90; s++) {
+            step_n(w, 1, DT);
+            carom_world_stats st = carom_world_stats_init();
+            carom_world_get_stats(w, &st);
+            if (st.contacts > most) most = st.contacts;
+        }
+        assert_true(most >= 64);
+        for (int i = 0; i < 96; i++) {
+            land[compact][i] = pos(w, ids[i]);
+            assert_int_equal(carom_body_get_orientation(w, ids[i], &turn[compact][i]), CAROM_OK);
+        }
+        carom_world_destroy(w);
+    }
+    for (int i = 0; i < 96; i++) {
+        double dp = fabs(land[0][i].x - land[1][i].x) + fabs(land[0][i].y - land[1][i].y) + fabs(land[0][i].z - land[1][i].z);
+        double dq = fabs(turn[0][i].w - turn[1][i].w) + fabs(turn[0][i].x - turn[1][i].x) +
+                    fabs(turn[0][i].y - turn[1][i].y) + fabs(turn[0][i].z - turn[1][i].z);
+        if (!(dp < 1e-9 && dq < 1e-9)) {
+            print_error("tilted box %d (ground %s): compact rows differ by %.3g m, %.3g in the orientation\n", i,
+                        ground_last ? "last" : "first", dp, dq);
+            fail();
+        }
+    }
+    }
+    setenv("CAROM_WIDE_COMPACT", "1", 1);
+    test_wide_passes_match_scalar(state);
+    test_wide_locked_match_scalar(state);
+    test_wide_kernels_agree(state);
+    test_mass_ratio_holds_in_a_wide_step(state);
+    unsetenv("CAROM_WIDE_COMPACT");
+}
+
 /* A resting box sags into the ground by the soft contact's static deflection,
  * g / omega^2, with omega = 2 pi f and f twice contact_hertz against a static
  * body (60 Hz by default, 120 Hz at the accurate preset), at any size. */
@@ -1292,6 +1394,7 @@ int main(void)
         cmocka_unit_test(test_wide_kernels_agree),
         cmocka_unit_test(test_wide_locked_match_scalar),
         cmocka_unit_test(test_mass_ratio_holds_in_a_wide_step),
+        cmocka_unit_test(test_compact_rows_match),
         cmocka_unit_test(test_resting_sag_is_the_soft_deflection),
         cmocka_unit_test(test_contact_modes_swing_at_the_setting),
         cmocka_unit_test(test_cylinder_rolls_on_plane_and_box),
