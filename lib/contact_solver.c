@@ -67,47 +67,38 @@ static void solve_rolling(contact_constraint *c, vec3 *wA, vec3 *wB, const impul
  * solved holding more than its share, a torque that rocks a symmetric stack
  * and walks it sideways (a 10-box column at default walked 3.4 mm in 10 s,
  * a 2-box stack at fast on a box ground 3.6 cm, and the 20-tower at default
- * leaned 0.34 m). With K the rows' coupling,
- * K_ij = 1/mA + 1/mB + (IA^-1 (ra_i x n)).(ra_j x n) + (IB^-1 (rb_i x n)).(rb_j x n),
- * the block is the linear complementarity problem on the totals x:
+ * leaned 0.34 m). The soft row of point i (make_softness:
+ * lambda = -(s_m / K_ii)(vn + bias) - s_i acc) is the exact solution of
+ * (K_ii + c_i) lambda + vn + bias + c_i acc = 0 with the compliance
+ * c_i = K_ii s_i / s_m (0 for a rigid row), so the block version for all
+ * points is the linear complementarity problem on the totals x:
  *     w = A x + b >= 0,  x >= 0,  x.w = 0,
- *     A = K + C + E,  b = vn + bias - K acc - E acc,
- * (Box2D v2 solved its 2-point case by enumeration; here 2 to 4 points),
- * C the soft rows' compliance, E = BLOCK_EPS diag(K) a regularisation of
- * the change x - acc only, so that rigid rows keep what K cannot see.
+ *     A = K + C,  b = vn + bias - K acc,
+ * K_ij = 1/mA + 1/mB + (IA^-1 (ra_i x n)).(ra_j x n) + (IB^-1 (rb_i x n)).(rb_j x n)
+ * (Box2D v2 solved its 2-point case by enumeration; here 2 to 4 points).
+ * K is singular for 4 coplanar points held rigidly (a relax pass): a
+ * compliance of BLOCK_EPS K_ii more keeps A positive definite and, for a
+ * consistent right-hand side, picks the least-norm totals (the even split
+ * of a symmetric load); it changes a row's velocity by BLOCK_EPS of its own
+ * response. A is positive definite, so the problem has one solution. K is
+ * built once a step (contact_prepare), and A's LDL^T factor (no square
+ * roots) for every row soft and for every row rigid at the first solve that
+ * reads it; a solve whose rows all touch or all are rigid is
+ * Delta = -A^-1 (vn + bias + (C + E) acc), and when a total would go
+ * negative, or the rows mix, the active sets are tried from all points
+ * down, the first feasible one is it.
  *
- * The compliance is modal. A soft row alone (make_softness) is
- * lambda = -s_m K_ii^-1 (vn + bias) - s_i acc, a spring of the setting's
- * frequency on the row's effective mass; for the block the same spring acts
- * on each of the manifold's modes: C = gamma K (gamma = s_i / s_m), so that
- * Delta = -s_m K^-1 (vn + bias) - s_i acc, the row formula with K for K_ii.
- * A compliance gamma diag(K) (one spring per point, as the sweep has) gives
- * a cube's tilting modes 1.22 times the frequency of its rows (their
- * inverse mass is 1.5 diag(K)), a flat box's up to 1.38 times, past the
- * quarter of the sub-step rate the loaded stiffening goes to, and columns
- * of boxes turned by a degree swayed and walked: 10 boxes offset up to
- * 2 mm and turned up to 1.1 degrees, mean sideways walk of the top box
- * after 10 s over 64 seeds, with manifolds that keep their points (reuse
- * distance 1e-3 m) fast 4.70 -> 0.53 cm, default 1.20 -> 0.12, accurate
- * 0.27 -> 0.00; at the presets' own reuse distances 4.70 -> 0.53, 5.35 ->
- * 4.87, 0.96 -> 1.54 (what walks there is a manifold whose reduced points
- * change from step to step).
- *
- * The null direction. The normal rows move only three freedoms (along n,
- * and the two turns about axes across it), so 4 points leave K singular:
- * its null vector z (sum z_i = 0, sum z_i p_i = 0 over the points p_i in
- * the face plane; z_i are the signed areas of the other three points'
- * triangles) shares a load between the points without any motion. No
- * velocity reaches it (z.vn = 0), only the bias can. It gets a compliance
- * of its own, gamma z^T diag(K) z / |z|^2 (what the per-point springs give
- * it), and a rigid row leaves it as it was. Both passes then use one
- * factor: M = K + s_i a z z^T + E, a = z^T diag(K) z / |z|^4, and
- *     soft rows:  Delta = -s_m M^-1 vb - s_i acc - (1 - s_i) z (z.acc) / |z|^2,
- *     rigid rows: Delta = -M^-1 vb + z (z.vb) / (s_i a |z|^4),
- * vb = vn + bias (the second term, only where s_i > 0, takes back M's null
- * part). M is factored (LDL^T, no square roots) at the first solve that
- * reads it; when a total would go negative, or the rows mix, the active
- * sets are tried from all points down, the first feasible one is it. */
+ * The compliance is one spring per point. It gives a face's tilt modes more
+ * than the rows' frequency (a cube's 1.22 times: their inverse mass is 1.5
+ * diag(K)). Tried and taken back (8d293a7): the modal compliance
+ * C = (s_i / s_m) K (every mode at the setting's frequency), which stopped
+ * columns of turned boxes swaying at fast (10 boxes offset up to 2 mm and
+ * turned up to 1.1 degrees, mean sideways walk after 10 s, 64 seeds:
+ * 4.70 -> 0.53 cm); but its springs couple the points, so a point that
+ * lifts off or lands changes the others' forces at once, and boxes resting
+ * tilted on a point or two that toggled between touching and apart never
+ * settled: of 48 random piles of 30 boxes, 23 still moved after 20 s at
+ * default (3 with this), 6 at accurate (1). */
 #define BLOCK_EPS 1e-9
 
 /* LDL^T factor of an n x n positive definite A: L (unit diagonal) below the
@@ -259,22 +250,21 @@ static int block_loaded_softness(const contact_constraint *c, const step_context
     return 1;
 }
 
-/* The soft rows' impulse_scale s_i and mass_scale s_m (0 and 1: rigid). */
-static void block_scales(const contact_constraint *c, const step_context *ctx, double *si, double *sm)
+/* The soft rows' compliance factor gamma: c_i = gamma K_ii (0: rigid rows). */
+static double block_gamma(const contact_constraint *c, const step_context *ctx)
 {
-    int soft = ctx->correction == CAROM_CORRECTION_SOFT && c->soft.impulse_scale > 0.0;
-    *si = soft ? c->soft.impulse_scale : 0.0;
-    *sm = soft ? c->soft.mass_scale : 1.0;
+    int soft = ctx->correction == CAROM_CORRECTION_SOFT;
+    return soft && c->soft.mass_scale > 0.0 ? c->soft.impulse_scale / c->soft.mass_scale : 0.0;
 }
 
-/* K and the null vector of an unlocked manifold of 2-4 points (after its
- * rows); the factor waits for the first solve (block_factor_m). */
+/* K of an unlocked manifold of 2-4 points (after its rows); the factors
+ * wait for the first solve that reads them (block_inverse). */
 static void block_prepare(contact_constraint *c, contact_block *blk, const step_context *ctx, double mA, double mB)
 {
     const int count = c->count;
     double lin = mA + mB;
     blk->ready = 0;
-    blk->factored = 0;
+    blk->factored[0] = blk->factored[1] = 0;
     blk->shock_ready = 0;
     if (count < 2 || c->locked) return;
     softness setting = c->soft; /* kept for a manifold that ends up swept */
@@ -290,45 +280,53 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
             blk->K[i][j] = blk->K[j][i] = lin + v3_dot(p->ia_n, q->ra_n) + v3_dot(p->ib_n, q->rb_n);
         }
     }
-    blk->zz = blk->za = 0.0;
-    blk->z[0] = blk->z[1] = blk->z[2] = blk->z[3] = 0.0; /* 2-3 points: no null vector */
-    if (count == 4) {
-        double px[4], py[4];
-        for (int i = 0; i < 4; i++) {
-            px[i] = v3_dot(c->an[i].ra, c->t1);
-            py[i] = v3_dot(c->an[i].ra, c->t2);
-        }
-        /* z_i = (-1)^i det[1 p_j; 1 p_k; 1 p_l] over the other three, in order */
-        for (int i = 0; i < 4; i++) {
-            int a = i == 0 ? 1 : 0, b = i <= 1 ? 2 : 1, d = i <= 2 ? 3 : 2;
-            double det = (px[b] - px[a]) * (py[d] - py[a]) - (px[d] - px[a]) * (py[b] - py[a]);
-            blk->z[i] = (i & 1) ? -det : det;
-            blk->zz += blk->z[i] * blk->z[i];
-        }
-        double zdz = 0.0;
-        for (int i = 0; i < 4; i++) zdz += blk->z[i] * blk->z[i] * blk->K[i][i];
-        /* collinear points (every triangle flat) have no single null vector: E holds them */
-        if (blk->zz > 0.0) blk->za = zdz / (blk->zz * blk->zz);
-    }
     blk->ready = 1;
 }
 
-/* M = K + s_i a z z^T + E factored; 0 when it cannot be (the block is then
- * solved by enumeration). */
-static int block_factor_m(const contact_constraint *c, contact_block *blk, const step_context *ctx)
+/* The factor of K + (gamma + BLOCK_EPS) diag(K) (soft 1: every row soft) or
+ * K + BLOCK_EPS diag(K) (soft 0: every row rigid), made at its first use;
+ * NULL when it cannot be (the block is then solved by enumeration). */
+static double (*block_inverse(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft))[4]
 {
-    const int count = c->count;
-    double si, sm, M[4][4];
-    block_scales(c, ctx, &si, &sm);
-    double k = blk->zz > 0.0 ? si * blk->za : 0.0;
-    for (int i = 0; i < count; i++) {
-        for (int j = 0; j < count; j++) M[i][j] = blk->K[i][j] + k * blk->z[i] * blk->z[j];
-        M[i][i] += BLOCK_EPS * blk->K[i][i];
+    if (!blk->factored[soft]) {
+        const int count = c->count;
+        double e = (soft ? block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
+        for (int i = 0; i < count; i++) {
+            for (int j = 0; j < count; j++) A[i][j] = blk->K[i][j];
+            A[i][i] += e * blk->K[i][i];
+        }
+        blk->factored[soft] = block_factor(count, A, blk->inv[soft]) ? 1 : -1;
     }
-    blk->factored = block_factor(count, M, blk->inv) ? 1 : -1;
-    /* what the rigid rows take back of M's null part: 1 / (s_i a |z|^4) */
-    blk->null_rigid = k > 0.0 ? 1.0 / (k * blk->zz * blk->zz) : 0.0;
-    return blk->factored > 0;
+    return blk->factored[soft] > 0 ? blk->inv[soft] : NULL;
+}
+
+/* Solves the block for the totals x (see above) given each row's vn + bias
+ * in vb, its compliance factor e_i (c_i = e_i K_ii, BLOCK_EPS included) and
+ * the inverse for a uniform factor (NULL: mixed). 0: sweep instead. */
+static int block_totals(int count, double K[4][4], double inv[4][4], const double vb[4], const double e[4],
+                        const double acc[4], double x[4])
+{
+    if (inv) {
+        double r[4], d[4];
+        for (int i = 0; i < count; i++) r[i] = vb[i] + e[i] * K[i][i] * acc[i];
+        block_apply(count, inv, r, d);
+        int ok = 1;
+        for (int i = 0; i < count; i++) {
+            x[i] = acc[i] - d[i];
+            ok &= x[i] >= 0.0;
+        }
+        if (ok) return 1;
+    }
+    double A[4][4], b[4];
+    for (int i = 0; i < count; i++) {
+        b[i] = vb[i];
+        for (int j = 0; j < count; j++) {
+            A[i][j] = K[i][j];
+            b[i] -= K[i][j] * acc[j];
+        }
+        A[i][i] += e[i] * K[i][i];
+    }
+    return block_lcp(count, A, b, x, inv ? count - 1 : count);
 }
 
 /* The normal rows of an unlocked manifold of 2-4 points solved as a block;
@@ -342,62 +340,27 @@ static int solve_normals_block(contact_constraint *c, contact_block *blk, const 
     vec3 dqa = ctx->dq[c->a], dqb = ctx->dq[c->b];
     int soft = ctx->correction == CAROM_CORRECTION_SOFT;
     int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
-    double si, sm;
-    block_scales(c, ctx, &si, &sm);
-    double vb[4] = {0.0, 0.0, 0.0, 0.0}, x[4], acc[4]; /* vb zeroed: GCC cannot see count <= 4 */
-    int soft_rows = 0, is_soft[4];
+    double gamma = block_gamma(c, ctx) + BLOCK_EPS;
+    double vb[4], e[4], x[4], acc[4];
+    int soft_rows = 0;
     for (int i = 0; i < count; i++) {
         const constraint_rows *r = &c->r[i];
         double s = c->an[i].base_separation + v3_dot(n, dpab) + v3_dot(dqb, r->rb_n) - v3_dot(dqa, r->ra_n);
         double bias = 0.0;
-        is_soft[i] = 0;
+        e[i] = BLOCK_EPS;
         if (s > 0.0) {
             bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
         } else if (push) {
             bias = CONTACT_PUSH_BIAS(soft, s, c->soft.bias_rate, ctx->baumgarte_rate, ctx->slop, -ctx->push_max, 0.0,
                                      dmax, dmin);
-            is_soft[i] = si > 0.0;
-            soft_rows += is_soft[i];
+            e[i] = gamma;
+            soft_rows++;
         }
         vb[i] = v3_dot(n, v3_sub(*vB, *vA)) + v3_dot(*wB, r->rb_n) - v3_dot(*wA, r->ra_n) + bias;
         acc[i] = c->p[i].normal_impulse;
     }
-    int uniform = soft_rows == count || soft_rows == 0, ok = 0;
-    if (uniform && (blk->factored > 0 || (!blk->factored && block_factor_m(c, blk, ctx)))) {
-        double d[4];
-        block_apply(count, blk->inv, vb, d);
-        if (soft_rows) {
-            double za = 0.0;
-            for (int i = 0; i < count; i++) za += blk->z[i] * acc[i];
-            za = blk->zz > 0.0 ? (1.0 - si) * za / blk->zz : 0.0;
-            for (int i = 0; i < count; i++) d[i] = sm * d[i] + si * acc[i] + za * blk->z[i];
-        } else if (blk->null_rigid > 0.0) {
-            double zv = 0.0;
-            for (int i = 0; i < count; i++) zv += blk->z[i] * vb[i];
-            zv *= blk->null_rigid;
-            for (int i = 0; i < count; i++) d[i] -= zv * blk->z[i];
-        }
-        ok = 1;
-        for (int i = 0; i < count; i++) {
-            x[i] = acc[i] - d[i];
-            ok &= x[i] >= 0.0;
-        }
-    }
-    if (!ok) {
-        /* C = gamma (K + a |z|^2 z z^T) among the soft rows */
-        double A[4][4], b[4], gamma = si > 0.0 ? si / sm : 0.0;
-        double ka = blk->zz > 0.0 ? gamma * blk->za : 0.0;
-        for (int i = 0; i < count; i++) {
-            b[i] = vb[i] - BLOCK_EPS * blk->K[i][i] * acc[i];
-            for (int j = 0; j < count; j++) {
-                double C = is_soft[i] && is_soft[j] ? gamma * blk->K[i][j] + ka * blk->z[i] * blk->z[j] : 0.0;
-                A[i][j] = blk->K[i][j] + C;
-                b[i] -= blk->K[i][j] * acc[j];
-            }
-            A[i][i] += BLOCK_EPS * blk->K[i][i];
-        }
-        if (!block_lcp(count, A, b, x, uniform && blk->factored > 0 ? count - 1 : count)) return 0;
-    }
+    double(*inv)[4] = soft_rows == count || soft_rows == 0 ? block_inverse(c, blk, ctx, soft_rows == count) : NULL;
+    if (!block_totals(count, blk->K, inv, vb, e, acc, x)) return 0;
     for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
         const constraint_rows *r = &c->r[i];
@@ -637,27 +600,7 @@ static int shock_normals_block(contact_constraint *c, contact_block *blk, const 
         acc[i] = p->normal_impulse;
         e[i] = BLOCK_EPS;
     }
-    /* rigid rows, E on the totals: Delta = -(K + E)^-1 (vb + E acc) */
-    double r[4], d[4];
-    int ok = 1;
-    for (int i = 0; i < count; i++) r[i] = vb[i] + e[i] * blk->shock_K[i][i] * acc[i];
-    block_apply(count, blk->shock_inv, r, d);
-    for (int i = 0; i < count; i++) {
-        x[i] = acc[i] - d[i];
-        ok &= x[i] >= 0.0;
-    }
-    if (!ok) {
-        double M[4][4], b[4];
-        for (int i = 0; i < count; i++) {
-            b[i] = vb[i];
-            for (int j = 0; j < count; j++) {
-                M[i][j] = blk->shock_K[i][j];
-                b[i] -= blk->shock_K[i][j] * acc[j];
-            }
-            M[i][i] += e[i] * blk->shock_K[i][i];
-        }
-        if (!block_lcp(count, M, b, x, count - 1)) return 0;
-    }
+    if (!block_totals(count, blk->shock_K, blk->shock_inv, vb, e, acc, x)) return 0;
     for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
         double lambda = x[i] - acc[i];

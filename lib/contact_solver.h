@@ -11,11 +11,10 @@
  * in the step's block (step_context.blocks, indexed as the constraints). */
 typedef struct contact_block {
     double K[4][4];              /* J M^-1 J^T of the normal rows */
-    double inv[4][4];            /* LDL^T of K + s_i a z z^T + E (contact_solver.c), once factored */
-    double z[4], zz, za;         /* K's null vector (4 points), |z|^2, z^T diag(K) z / |z|^4; zz 0: none */
-    double null_rigid;           /* 1 / (s_i a |z|^4): rigid rows take M's null part back (0: none) */
+    double inv[2][4][4];         /* LDL^T of K + E (every row rigid) and K + C + E (every row soft), once made */
     double shock_K[4][4], shock_inv[4][4]; /* the shock pass's, built at its first call */
-    int ready, factored;         /* ready 0: sweep the rows one by one; factored 1 done, -1 failed, 0 not yet */
+    int ready;                   /* 0: sweep the rows one by one */
+    int factored[2];             /* inv[k]: 1 made, -1 failed, 0 not yet */
     int shock_ready;
 } contact_block;
 
