@@ -115,6 +115,16 @@ void events_raise_forces(carom_world *w, const contact_constraint *constraints, 
         }
         double force = total / dt;
         if (!(force > threshold)) continue;
-        events_force(w, con->contact, force * dt, force, v3_scale(weighted, 1.0 / total));
+        /* a subnormal total (under a subnormal threshold) has no finite
+         * reciprocal: the point of the largest impulse instead */
+        double inv = 1.0 / total;
+        vec3 point = v3_scale(weighted, inv);
+        if (!isfinite(inv)) {
+            int best = 0;
+            for (int j = 1; j < con->count; j++)
+                if (con->p[j].total_normal_impulse > con->p[best].total_normal_impulse) best = j;
+            point = con->m->points[best].point;
+        }
+        events_force(w, con->contact, force * dt, force, point);
     }
 }
