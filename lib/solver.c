@@ -521,6 +521,37 @@ static void keep_hint(solver_memory *sm, const int *touching, int n, int contact
     sm->last_count = n;
 }
 
+/* The touching manifolds' keys, each from its own manifold: in ranges (the
+ * reads of every manifold's points were a fifth of world_solve's own time
+ * at 50,000 bodies). */
+typedef struct key_job {
+    const carom_world *w;
+    order_key *keys;
+    vec3 up, e1, e2;
+} key_job;
+
+static void order_keys_range(int begin, int end, int worker, void *p)
+{
+    const key_job *j = p;
+    /* locals: the stores to the keys could alias the job's fields */
+    const contact_set *cs = &j->w->contacts;
+    const int *touching = j->w->scratch.touching;
+    order_key *keys = j->keys;
+    const vec3 up = j->up, e1 = j->e1, e2 = j->e2;
+    (void)worker;
+    for (int k = begin; k < end; k++) {
+        const manifold *m = &CONTACT_DATA(cs, touching[k])->m;
+        vec3 c = v3_zero();
+        for (int i = 0; i < m->count; i++) c = v3_add(c, m->points[i].point);
+        c = v3_scale(c, 1.0 / m->count);
+        keys[k].k[0] = v3_dot(c, up);
+        keys[k].k[1] = v3_dot(c, e1);
+        keys[k].k[2] = v3_dot(c, e2);
+        keys[k].contact = touching[k];
+        keys[k].points = m->count;
+    }
+}
+
 /* Also leaves each manifold's point count in solve order in sm->points:
  * build_constraints reads them there, in sequence, instead of twice from
  * the contact data in the sorted order (a cache miss per manifold at 50,000
@@ -538,20 +569,14 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     /* keys, then merge space, then the hinted order */
     if (!array_reserve(&sm->order, &sm->order_capacity, 3 * n, sizeof(order_key))) return 0;
     order_key *keys = sm->order;
-    vec3 up = v3_len2(ctx->gravity) > 0.0 ? v3_normalize(v3_neg(ctx->gravity)) : v3(0, 0, 1);
-    vec3 e1, e2;
-    v3_basis(up, &e1, &e2);
+    key_job job;
+    job.w = w;
+    job.keys = keys;
+    job.up = v3_len2(ctx->gravity) > 0.0 ? v3_normalize(v3_neg(ctx->gravity)) : v3(0, 0, 1);
+    v3_basis(job.up, &job.e1, &job.e2);
+    tasks_run(ctx->tasks, n, CONSTRAINT_MIN_RANGE, order_keys_range, &job);
     int sorted = 1, nan = 0;
     for (int k = 0; k < n; k++) {
-        const manifold *m = &CONTACT_DATA(&w->contacts, s->touching[k])->m;
-        vec3 c = v3_zero();
-        for (int j = 0; j < m->count; j++) c = v3_add(c, m->points[j].point);
-        c = v3_scale(c, 1.0 / m->count);
-        keys[k].k[0] = v3_dot(c, up);
-        keys[k].k[1] = v3_dot(c, e1);
-        keys[k].k[2] = v3_dot(c, e2);
-        keys[k].contact = s->touching[k];
-        keys[k].points = m->count;
         nan |= keys[k].k[0] != keys[k].k[0] || keys[k].k[1] != keys[k].k[1] || keys[k].k[2] != keys[k].k[2];
         if (k > 0 && sorted && by_order_key(&keys[k - 1], &keys[k]) > 0) sorted = 0;
     }
@@ -907,40 +932,78 @@ static void finish_impacts(carom_world *w, const step_context *ctx, const solver
     if (work->impacts) impact_finish(w, ctx->body_count);
 }
 
+/* A manifold's hit-event test: the fastest approach at a point before
+ * solving (its speed and point in *approach, *deepest) above the threshold,
+ * and some normal impulse. */
+static int hit_of(const contact_constraint *con, double threshold, double *approach, double *total, int *deepest)
+{
+    *approach = 0.0;
+    *total = 0.0;
+    *deepest = 0;
+    for (int j = 0; j < con->count; j++) {
+        const constraint_point *p = &con->p[j];
+        *total += p->total_normal_impulse;
+        if (-p->relative_velocity > *approach) { *approach = -p->relative_velocity; *deepest = j; }
+    }
+    return *approach > threshold && *total > 0.0;
+}
+
+typedef struct impulse_job {
+    carom_world *w;
+    const step_context *ctx;
+    const contact_constraint *cc;
+    unsigned char *hit;          /* per constraint: hit_of (NULL: raise_hit_events tests them itself) */
+} impulse_job;
+
+/* The impulses back to the contacts, and (while the points are at hand:
+ * a second pass over them was a tenth of world_solve's own time at 50,000
+ * bodies) which manifolds raise a hit event. */
 static void store_impulses_range(int begin, int end, int worker, void *p)
 {
-    const constraint_job *job = p;
+    const impulse_job *job = p;
+    /* locals: the byte stores to hit may alias anything */
+    const contact_set *cs = &job->w->contacts;
+    const contact_constraint *cc = job->cc;
+    unsigned char *hit = job->hit;
+    double threshold = job->ctx->hit_event_threshold;
     (void)worker;
     for (int c = begin; c < end; c++) {
-        const contact_constraint *con = &job->cc[c];
-        contact_data *cd = CONTACT_DATA(&job->w->contacts, con->contact);
+        const contact_constraint *con = &cc[c];
+        contact_data *cd = CONTACT_DATA(cs, con->contact);
         for (int j = 0; j < con->count; j++) {
             const constraint_point *p = &con->p[j];
             cd->state[j].normal_impulse = p->normal_impulse;
             cd->state[j].tangent_impulse[0] = p->tangent_impulse[0];
             cd->state[j].tangent_impulse[1] = p->tangent_impulse[1];
         }
+        if (hit) {
+            double approach, total;
+            int deepest;
+            hit[c] = (unsigned char)hit_of(con, threshold, &approach, &total, &deepest);
+        }
     }
 }
 
-static void store_impulses(carom_world *w, const step_context *ctx)
+/* Returns the hit flags per constraint, or NULL (out of memory: raise_hit_events tests every manifold). */
+static const unsigned char *store_impulses(carom_world *w, const step_context *ctx)
 {
-    constraint_job job = {w, ctx, ctx->constraints, NULL};
-    tasks_run(ctx->tasks, ctx->constraint_count, CONSTRAINT_MIN_RANGE, store_impulses_range, &job);
+    solver_memory *sm = &w->scratch.solver;
+    int n = ctx->constraint_count;
+    impulse_job job = {w, ctx, ctx->constraints, NULL};
+    if (array_reserve((void **)&sm->hit, &sm->hit_capacity, n > 0 ? n : 1, sizeof *sm->hit)) job.hit = sm->hit;
+    tasks_run(ctx->tasks, n, CONSTRAINT_MIN_RANGE, store_impulses_range, &job);
+    return job.hit;
 }
 
-static void raise_hit_events(carom_world *w, const step_context *ctx)
+/* In constraint order (events are raised in it): the manifolds store_impulses flagged. */
+static void raise_hit_events(carom_world *w, const step_context *ctx, const unsigned char *hit)
 {
     for (int c = 0; c < ctx->constraint_count; c++) {
+        if (hit && !hit[c]) continue;
         const contact_constraint *con = &ctx->constraints[c];
-        double approach = 0.0, total = 0.0, tangent = 0.0;
-        int deepest = 0;
-        for (int j = 0; j < con->count; j++) {
-            const constraint_point *p = &con->p[j];
-            total += p->total_normal_impulse;
-            if (-p->relative_velocity > approach) { approach = -p->relative_velocity; deepest = j; }
-        }
-        if (!(approach > ctx->hit_event_threshold && total > 0.0)) continue;
+        double approach, total, tangent = 0.0;
+        int deepest;
+        if (!hit_of(con, ctx->hit_event_threshold, &approach, &total, &deepest)) continue;
         for (int j = 0; j < con->count; j++) {
             const constraint_point *p = &con->p[j];
             tangent += sqrt(p->tangent_impulse[0] * p->tangent_impulse[0] + p->tangent_impulse[1] * p->tangent_impulse[1]) *
@@ -1056,6 +1119,7 @@ void solver_memory_free(solver_memory *m)
     free(m->wide);
     free(m->order);
     free(m->points);
+    free(m->hit);
     free(m->last_order);
     free(m->mark);
     free(m->motion);
@@ -1081,8 +1145,8 @@ int world_solve(carom_world *w, step_context *ctx)
     }
     store_wide(ctx, &work);
     finish_impacts(w, ctx, &work);
-    store_impulses(w, ctx);
-    raise_hit_events(w, ctx);
+    const unsigned char *hit = store_impulses(w, ctx);
+    raise_hit_events(w, ctx, hit);
     events_raise_forces(w, ctx->constraints, ctx->constraint_count, ctx->dt);
     finish_bodies(w, ctx, &work);
     return 1;

@@ -24,6 +24,8 @@ typedef struct solver_memory {
     int order_capacity;
     int *points;                 /* this step: each touching manifold's point count, in solve order */
     int points_capacity;
+    unsigned char *hit;          /* this step: per constraint, 1 when it raises a hit event (store_impulses) */
+    int hit_capacity;
     /* sort_touching's hint: last step's solve order (contact indices) and a
      * zeroed per-contact mark; only the work of the sort depends on them */
     int *last_order, *mark;
