@@ -646,6 +646,27 @@ LANE_INLINE void gather_manifolds(const wide_batch *wb, contact_constraint *cc, 
 /* A point's rows: the arms crossed with the basis, those through the inverse
  * inertias, and the effective masses as solver.c:
  * 1 / (1/mA + 1/mB + (IA^-1 (rA x n)).(rA x n) + ...) */
+/* Point i of the four lanes' manifolds: its warm-start state, its arms from
+ * each body's centre and its separation (an empty lane reads a zero point). */
+LANE_INLINE void gather_point(const lane_manifolds *lm, int i, const contact_point_state *st[LANES], lane_t ra[3],
+                              lane_t rb[3], lane_t *sep)
+{
+    static const manifold_point no_point = {{0, 0, 0}, 0, 0};
+    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
+    const manifold_point *mp[LANES];
+    for (int l = 0; l < LANES; l++) {
+        mp[l] = lm->c[l] ? &lm->c[l]->m->points[i] : &no_point;
+        st[l] = lm->c[l] ? &lm->c[l]->warm[i] : &no_state;
+    }
+    lane_t point[3];
+    gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
+    SET_LANES(*sep, mp[0], mp[1], mp[2], mp[3], separation);
+    for (int d = 0; d < 3; d++) {
+        ra[d] = point[d] - lm->center_a[d];
+        rb[d] = point[d] - lm->center_b[d];
+    }
+}
+
 LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wide_point *p, const lane_t ra[3],
                               const lane_t rb[3], const lane_t lin[3])
 {
@@ -717,8 +738,6 @@ LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, i
 LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_constraint *cc,
                                  const impulse_body *bodies, double warm, const wide_lock *lk)
 {
-    static const manifold_point no_point = {{0, 0, 0}, 0, 0};
-    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm);
     /* the linear share of each row's inverse effective mass (n, t1, t2) */
@@ -733,20 +752,9 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     double deepest = 0.0;
     for (int i = 0; i < wb->count; i++) {
         wide_point *p = &pts[i];
-        const manifold_point *mp[LANES];
         const contact_point_state *st[LANES];
-        for (int l = 0; l < LANES; l++) {
-            mp[l] = lm.c[l] ? &lm.c[l]->m->points[i] : &no_point;
-            st[l] = lm.c[l] ? &lm.c[l]->warm[i] : &no_state;
-        }
-        lane_t point[3], sep;
-        gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
-        SET_LANES(sep, mp[0], mp[1], mp[2], mp[3], separation);
-        lane_t ra[3], rb[3];
-        for (int d = 0; d < 3; d++) {
-            ra[d] = point[d] - lm.center_a[d];
-            rb[d] = point[d] - lm.center_b[d];
-        }
+        lane_t ra[3], rb[3], sep;
+        gather_point(&lm, i, st, ra, rb, &sep);
         prepare_rows(wb, &lm, p, ra, rb, lin);
         p->base_separation = sep;
         /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
@@ -1012,8 +1020,6 @@ LANE_INLINE void warm_cpoint(wide_cpoint *p, const contact_point_state *const st
 LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_cpoint *pts, contact_constraint *cc,
                                    const impulse_body *bodies, double warm, const wide_lock *lk)
 {
-    static const manifold_point no_point = {{0, 0, 0}, 0, 0};
-    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm);
@@ -1030,20 +1036,9 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     double deepest = 0.0;
     for (int i = 0; i < wb->count; i++) {
         wide_cpoint *p = &pts[i];
-        const manifold_point *mp[LANES];
         const contact_point_state *st[LANES];
-        for (int l = 0; l < LANES; l++) {
-            mp[l] = lm.c[l] ? &lm.c[l]->m->points[i] : &no_point;
-            st[l] = lm.c[l] ? &lm.c[l]->warm[i] : &no_state;
-        }
-        lane_t point[3], sep;
-        gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
-        SET_LANES(sep, mp[0], mp[1], mp[2], mp[3], separation);
-        lane_t ra[3], rb[3];
-        for (int d = 0; d < 3; d++) {
-            ra[d] = point[d] - lm.center_a[d];
-            rb[d] = point[d] - lm.center_b[d];
-        }
+        lane_t ra[3], rb[3], sep;
+        gather_point(&lm, i, st, ra, rb, &sep);
         TO_BASIS(p->ra, wb, ra);
         TO_BASIS(p->rb, wb, rb);
         const lane_t *a = p->ra, *b = p->rb;
