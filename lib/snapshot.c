@@ -39,6 +39,14 @@
 #define SNAP_HOST_LE 0
 #endif
 
+/* The hot readers and writers, inlined into every record's loop (GCC and
+ * clang otherwise keep the larger ones out of line: a call per value). */
+#if defined(__GNUC__)
+#define SNAP_INLINE static inline __attribute__((always_inline))
+#else
+#define SNAP_INLINE static inline
+#endif
+
 typedef struct writer {
     unsigned char *buf;
     size_t cap, pos;
@@ -226,16 +234,32 @@ static int get_count(reader *r, size_t record, int max, const char *what)
 
 /* ---- compact codes: varints, and doubles sent against a prediction -------------- */
 
-static void put_varint(writer *o, uint64_t v)
+static void put_varint_slow(writer *o, uint64_t v)
 {
     while (v >= 0x80) { put_u8(o, (unsigned)(v & 0x7f) | 0x80u); v >>= 7; }
     put_u8(o, (unsigned)v);
 }
 
+/* (inlined: one or two bytes, with room, stored directly) */
+SNAP_INLINE void put_varint(writer *o, uint64_t v)
+{
+    if (v < (1u << 14) && o->pos + 2 <= o->cap) {
+        if (v < 0x80) {
+            o->buf[o->pos++] = (unsigned char)v;
+        } else {
+            o->buf[o->pos] = (unsigned char)((v & 0x7f) | 0x80);
+            o->buf[o->pos + 1] = (unsigned char)(v >> 7);
+            o->pos += 2;
+        }
+        return;
+    }
+    put_varint_slow(o, v);
+}
+
 static uint64_t zigzag(int64_t v) { return ((uint64_t)v << 1) ^ (uint64_t)(v >> 63); }
 static int64_t unzigzag(uint64_t u) { return (int64_t)(u >> 1) ^ -(int64_t)(u & 1); }
 
-static uint64_t get_varint(reader *r, const char *what)
+static uint64_t get_varint_slow(reader *r, const char *what)
 {
     uint64_t v = 0;
     for (int shift = 0; shift < 64; shift += 7) {
@@ -254,9 +278,9 @@ static uint64_t get_varint(reader *r, const char *what)
 }
 
 /* A varint that must fit an int in [lo, hi]. */
-static int get_small(reader *r, int64_t lo, int64_t hi, int is_signed, const char *what)
+static int get_small_slow(reader *r, int64_t lo, int64_t hi, int is_signed, const char *what)
 {
-    uint64_t u = get_varint(r, what);
+    uint64_t u = get_varint_slow(r, what);
     if (r->failed) return 0;
     int64_t v = is_signed ? unzigzag(u) : (u > (uint64_t)INT64_MAX ? -1 : (int64_t)u);
     if (v < lo || v > hi || (!is_signed && u > (uint64_t)INT64_MAX)) {
@@ -264,6 +288,27 @@ static int get_small(reader *r, int64_t lo, int64_t hi, int is_signed, const cha
         return 0;
     }
     return (int)v;
+}
+
+/* A varint that must fit an int in [lo, hi]: a one- or two-byte one in
+ * range is taken here (inlined at every record's fields); anything else is
+ * read, and refused, by the checked way above from the same position. */
+SNAP_INLINE int get_small(reader *r, int64_t lo, int64_t hi, int is_signed, const char *what)
+{
+    if (!r->failed && r->size - r->pos >= 10) {
+        const unsigned char *p = r->buf + r->pos;
+        uint64_t u;
+        size_t len;
+        if (p[0] < 0x80) u = p[0], len = 1;
+        else if (p[1] < 0x80 && p[1] != 0) u = (uint64_t)(p[0] & 0x7f) | (uint64_t)p[1] << 7, len = 2;
+        else return get_small_slow(r, lo, hi, is_signed, what);
+        int64_t v = is_signed ? unzigzag(u) : (int64_t)u;
+        if (v >= lo && v <= hi) {
+            r->pos += len;
+            return (int)v;
+        }
+    }
+    return get_small_slow(r, lo, hi, is_signed, what);
 }
 
 static uint64_t f64_bits(double d)
@@ -281,7 +326,7 @@ static uint64_t f64_bits(double d)
 #define CODED_MAX 8
 
 /* The one tag the writer picks for an XOR (the reader refuses any other). */
-static int coded_tag(uint64_t x)
+SNAP_INLINE int coded_tag(uint64_t x)
 {
     if (x == 0) return 0;
     int lead, trail;
@@ -293,14 +338,22 @@ static int coded_tag(uint64_t x)
     while (!((x >> (56 - 8 * lead)) & 0xff)) lead++;
     while (!((x >> (8 * trail)) & 0xff)) trail++;
 #endif
-    if (trail > 0 && trail > lead) return 8 + trail; /* keep the high 8 - trail bytes */
-    return 8 - lead;                                 /* keep the low 8 - lead bytes */
+    /* (trail > lead implies trail > 0) */
+    return trail > lead ? 8 + trail  /* keep the high 8 - trail bytes */
+                        : 8 - lead;  /* keep the low 8 - lead bytes */
 }
 
 /* A tag's payload length: 1..8 low bytes, 9..15 the high 16 - tag bytes. */
 static const unsigned char coded_len[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 7, 6, 5, 4, 3, 2, 1};
+/* The XOR from 8 bytes loaded at its payload (little-endian): (load & mask) << shift. */
+#define CODED_LOW(k) (((uint64_t)1 << (8 * (k))) - 1)
+static const uint64_t coded_mask[16] = {0, CODED_LOW(1), CODED_LOW(2), CODED_LOW(3), CODED_LOW(4), CODED_LOW(5),
+                                        CODED_LOW(6), CODED_LOW(7), ~(uint64_t)0, CODED_LOW(7), CODED_LOW(6),
+                                        CODED_LOW(5), CODED_LOW(4), CODED_LOW(3), CODED_LOW(2), CODED_LOW(1)};
+#undef CODED_LOW
+static const unsigned char coded_shift[16] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 8, 16, 24, 32, 40, 48, 56};
 
-static void put_coded(writer *o, const double *v, const double *pred, int n)
+static void put_coded_slow(writer *o, const double *v, const double *pred, int n)
 {
     uint64_t x[CODED_MAX];
     int tag[CODED_MAX];
@@ -336,8 +389,33 @@ static void put_coded(writer *o, const double *v, const double *pred, int n)
     o->pos += len;
 }
 
+/* The same, inlined: whole 8-byte stores while the group's bytes and 8 more
+ * fit in the buffer (the slow way above does the rest: measuring, the last
+ * records, big-endian hosts). */
+SNAP_INLINE void put_coded(writer *o, const double *v, const double *pred, int n)
+{
+    if (!SNAP_HOST_LE || o->pos + (size_t)(n + 1) / 2 + 8 * (size_t)n + 8 > o->cap) {
+        put_coded_slow(o, v, pred, n);
+        return;
+    }
+    uint64_t x[CODED_MAX];
+    int tag[CODED_MAX];
+    for (int i = 0; i < n; i++) {
+        x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
+        tag[i] = coded_tag(x[i]);
+    }
+    unsigned char *b = o->buf + o->pos;
+    for (int i = 0; i < n; i += 2) *b++ = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
+    for (int i = 0; i < n; i++) {
+        uint64_t u = x[i] >> coded_shift[tag[i]];
+        memcpy(b, &u, 8);
+        b += coded_len[tag[i]];
+    }
+    o->pos = (size_t)(b - o->buf);
+}
+
 /* The reader's side; every value decoded must be finite. */
-static void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
+static void get_coded_slow(reader *r, double *out, const double *pred, int n, const char *what)
 {
     size_t tags = (size_t)(n + 1) / 2;
     if (!need(r, tags, what)) {
@@ -375,26 +453,56 @@ static void get_coded(reader *r, double *out, const double *pred, int n, const c
         for (int i = 0; i < n; i++) out[i] = 0;
 }
 
-static void put_coded_v3(writer *o, vec3 v, vec3 pred)
+/* The same, without a bounds check per value while a whole group's largest
+ * encoding and 8 bytes more are left (every record but the last few): each
+ * value one 8-byte load. Anything it refuses goes to the checked way above,
+ * which finds the same error. */
+SNAP_INLINE void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
+{
+    size_t tags = (size_t)(n + 1) / 2;
+    if (SNAP_HOST_LE && !r->failed && r->size - r->pos >= 4 + 8 * (size_t)n + 8) {
+        const unsigned char *t = r->buf + r->pos, *p = t + tags;
+        uint32_t tw; /* (n <= 8: the tags fit 4 bytes; those past them are not read as tags) */
+        memcpy(&tw, t, 4);
+        int ok = !((n & 1) && ((tw >> (4 * n)) & 15));
+        for (int i = 0; i < n; i++) {
+            int tag = (int)((tw >> (4 * i)) & 15);
+            uint64_t x;
+            memcpy(&x, p, 8);
+            x = (x & coded_mask[tag]) << coded_shift[tag];
+            p += coded_len[tag];
+            uint64_t bits = x ^ f64_bits(pred[i]);
+            ok &= (coded_tag(x) == tag) & (((bits >> 52) & 0x7ff) != 0x7ff);
+            memcpy(&out[i], &bits, 8);
+        }
+        if (ok) {
+            r->pos = (size_t)(p - r->buf);
+            return;
+        }
+    }
+    get_coded_slow(r, out, pred, n, what);
+}
+
+SNAP_INLINE void put_coded_v3(writer *o, vec3 v, vec3 pred)
 {
     double a[3] = {v.x, v.y, v.z}, p[3] = {pred.x, pred.y, pred.z};
     put_coded(o, a, p, 3);
 }
 
-static vec3 get_coded_v3(reader *r, vec3 pred, const char *what)
+SNAP_INLINE vec3 get_coded_v3(reader *r, vec3 pred, const char *what)
 {
     double a[3], p[3] = {pred.x, pred.y, pred.z};
     get_coded(r, a, p, 3, what);
     return v3(a[0], a[1], a[2]);
 }
 
-static void put_coded_q(writer *o, quat q, quat pred)
+SNAP_INLINE void put_coded_q(writer *o, quat q, quat pred)
 {
     double a[4] = {q.w, q.x, q.y, q.z}, p[4] = {pred.w, pred.x, pred.y, pred.z};
     put_coded(o, a, p, 4);
 }
 
-static quat get_coded_q(reader *r, quat pred, const char *what)
+SNAP_INLINE quat get_coded_q(reader *r, quat pred, const char *what)
 {
     double a[4], p[4] = {pred.w, pred.x, pred.y, pred.z};
     get_coded(r, a, p, 4, what);
@@ -402,8 +510,8 @@ static quat get_coded_q(reader *r, quat pred, const char *what)
     return q;
 }
 
-static void put_coded1(writer *o, double v, double pred) { put_coded(o, &v, &pred, 1); }
-static double get_coded1(reader *r, double pred, const char *what)
+SNAP_INLINE void put_coded1(writer *o, double v, double pred) { put_coded(o, &v, &pred, 1); }
+SNAP_INLINE double get_coded1(reader *r, double pred, const char *what)
 {
     double v;
     get_coded(r, &v, &pred, 1, what);
@@ -880,8 +988,65 @@ static void class_table_free(class_table *t)
     free(t->of_body);
 }
 
+/* Whether bodies i and j write the same class bytes (write_class): every
+ * field it writes equal to the bit, the shape a primitive or a hull with
+ * the same numbers. 0 for meshes, height fields and compounds (the caller
+ * writes those and compares the bytes). */
+static int same_bits_v3(vec3 a, vec3 b) { return same_bits(&a, &b, sizeof a); }
+static int same_hull(const hull *a, const hull *b)
+{
+    if (a == b) return 1;
+    if (a->vertex_count != b->vertex_count || a->face_count != b->face_count || a->edge_count != b->edge_count ||
+        !same_bits(a->vertices, b->vertices, sizeof *a->vertices * (size_t)a->vertex_count) ||
+        !same_bits_v3(a->centroid, b->centroid) || f64_bits(a->volume) != f64_bits(b->volume) ||
+        !same_bits(&a->unit_inertia, &b->unit_inertia, sizeof a->unit_inertia) ||
+        !same_bits(a->edges, b->edges, sizeof *a->edges * (size_t)a->edge_count))
+        return 0;
+    int nfv = 0;
+    for (int f = 0; f < a->face_count; f++) {
+        const hull_face *x = &a->faces[f], *y = &b->faces[f];
+        if (!same_bits_v3(x->normal, y->normal) || f64_bits(x->offset) != f64_bits(y->offset) || x->first != y->first ||
+            x->count != y->count)
+            return 0;
+        if (x->first + x->count > nfv) nfv = x->first + x->count;
+    }
+    return same_bits(a->face_vertices, b->face_vertices, sizeof *a->face_vertices * (size_t)nfv);
+}
+static int same_shape(const shape *a, const shape *b)
+{
+    if (a->type != b->type) return 0;
+    switch (a->type) {
+    case SHAPE_SPHERE: return f64_bits(a->radius) == f64_bits(b->radius);
+    case SHAPE_BOX: return same_bits_v3(a->half_extents, b->half_extents);
+    case SHAPE_CAPSULE:
+    case SHAPE_CYLINDER: return f64_bits(a->radius) == f64_bits(b->radius) && f64_bits(a->half_height) == f64_bits(b->half_height);
+    case SHAPE_PLANE: return same_bits_v3(a->plane_normal, b->plane_normal) && f64_bits(a->plane_offset) == f64_bits(b->plane_offset);
+    case SHAPE_HULL: return same_hull(a->hull, b->hull);
+    default: return 0;
+    }
+}
+static int same_class(const body_store *s, int i, int j)
+{
+    return s->type[i] == s->type[j] && ((s->flags[i] ^ s->flags[j]) & ~(uint32_t)BODY_STATE_FLAGS) == 0 &&
+           same_bits_v3(s->local_center[i], s->local_center[j]) && f64_bits(s->mass[i]) == f64_bits(s->mass[j]) &&
+           same_bits(&s->inertia_local[i], &s->inertia_local[j], sizeof(mat3)) &&
+           f64_bits(s->friction[i]) == f64_bits(s->friction[j]) && f64_bits(s->restitution[i]) == f64_bits(s->restitution[j]) &&
+           f64_bits(s->linear_damping[i]) == f64_bits(s->linear_damping[j]) &&
+           f64_bits(s->angular_damping[i]) == f64_bits(s->angular_damping[j]) &&
+           f64_bits(s->gravity_scale[i]) == f64_bits(s->gravity_scale[j]) && same_bits_v3(s->plane_normal[i], s->plane_normal[j]) &&
+           s->category[i] == s->category[j] && s->filter_mask[i] == s->filter_mask[j] && s->group[i] == s->group[j] &&
+           f64_bits(s->force_threshold[i]) == f64_bits(s->force_threshold[j]) &&
+           f64_bits(s->rolling_resistance[i]) == f64_bits(s->rolling_resistance[j]) && s->combine[i] == s->combine[j] &&
+           same_shape(&s->shapes[i], &s->shapes[j]);
+}
+
+/* The last few classes seen, by a body of each: most bodies match one of
+ * them field by field (no bytes written, no hash) */
+#define RECENT_CLASSES 8
+
 static int build_classes(const body_store *s, class_table *t)
 {
+    int recent[RECENT_CLASSES], recent_count = 0, recent_next = 0;
     memset(t, 0, sizeof *t);
     int n = s->count;
     size_t total = 4096; /* grown as the distinct classes need (each written once) */
@@ -901,6 +1066,16 @@ static int build_classes(const body_store *s, class_table *t)
     for (int k = 0; k < cap; k++) slots[k] = -1;
     t->start[0] = 0;
     for (int i = 0; i < n; i++) {
+        int hit = -1;
+        for (int r = 0; r < recent_count && hit < 0; r++)
+            if (same_class(s, i, recent[r])) hit = recent[r];
+        if (hit >= 0) {
+            t->of_body[i] = t->of_body[hit];
+            continue;
+        }
+        recent[recent_next] = i;
+        recent_next = (recent_next + 1) % RECENT_CLASSES;
+        if (recent_count < RECENT_CLASSES) recent_count++;
         size_t at = t->start[t->count];
         writer o = {t->bytes, total, at, NULL};
         write_class(&o, s, i);
@@ -1058,6 +1233,8 @@ static void write_bodies(writer *o, const carom_world *w, const class_table *t, 
     }
 }
 
+static const xform identity_pose = {{0, 0, 0}, {1, 0, 0, 0}};
+
 /* B's frame in A's (as collision.c computes it). */
 static xform relative_pose(xform xa, xform xb)
 {
@@ -1075,15 +1252,14 @@ typedef struct reuse_motion {
     vec3 t;
 } reuse_motion;
 
-static reuse_motion reuse_guess(const contact *c, xform now)
+static void reuse_guess(const contact *c, const xform *now, reuse_motion *m)
 {
-    reuse_motion m = {0, m3_zero(), v3(0, 0, 0)};
-    if (!(c->flags & CONTACT_REUSABLE)) return m;
-    quat dq = q_mul(now.q, q_conj(c->rel_pose.q));
-    m.on = 1;
-    m.R = m3_from_quat(dq);
-    m.t = v3_sub(now.p, q_rotate(dq, c->rel_pose.p));
-    return m;
+    m->on = 0; /* (R and t are read only when on) */
+    if (!(c->flags & CONTACT_REUSABLE)) return;
+    quat dq = q_mul(now->q, q_conj(c->rel_pose.q));
+    m->on = 1;
+    m->R = m3_from_quat(dq);
+    m->t = v3_sub(now->p, q_rotate(dq, c->rel_pose.p));
 }
 
 /* A point's predicted world position and separation now, from its state. */
@@ -1108,6 +1284,9 @@ enum { CREC_FEATURE = 8, CREC_EXACT = 16, CREC_HAS_NORMAL = 32, CREC_TANGENT_GUE
        CREC_NORMAL = 256, CREC_SUB = 512, CREC_SUB_LIMIT = 1024, CREC_TANGENT = 2048, CREC_CACHE_NORMAL = 4096,
        CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_ALL = 131071 };
 #define CONTACT_FLAG_BITS 6
+/* The flags under which a pair's record has more than its ids, head and
+ * cache feature (its data is read, or it is posed) */
+#define IDLE_RECORD_FLAGS (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING | CONTACT_REUSABLE | CONTACT_APART)
 
 /* The friction basis the solver starts from for a normal (solver.c): the
  * kept basis of a resting contact is usually this, to the last bits. */
@@ -1121,9 +1300,11 @@ static int normal_is_state(const contact *c, const contact_data *d)
     return d->m.count > 0 || (c->flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING));
 }
 
-/* What the reader predicts from the two bodies, before the contact's numbers. */
+/* What the reader predicts from the two bodies, before the contact's numbers:
+ * their collided poses, and the material only for a pair with data (a pair
+ * without reads the bodies' mix: nothing to predict). */
 typedef struct contact_guess {
-    xform xa, xb;
+    const xform *xa, *xb;
     double material[3]; /* friction, restitution, rolling resistance as material.c mixes them */
 } contact_guess;
 
@@ -1157,11 +1338,8 @@ static double body_reach(const body_store *s, mix_memo *memo, int slot)
     return memo->reach[k];
 }
 
-static contact_guess guess_contact(const body_store *s, mix_memo *memo, const xform *pose, int a, int b, uint32_t sub)
+static void guess_material(const body_store *s, mix_memo *memo, int a, int b, uint32_t sub, contact_guess *g)
 {
-    contact_guess g;
-    g.xa = pose[a];
-    g.xb = pose[b];
     int ka = memo ? memo->class_of[a] : MIX_MEMO_CLASSES, kb = memo ? memo->class_of[b] : MIX_MEMO_CLASSES;
     if (sub == 0 && ka < MIX_MEMO_CLASSES && kb < MIX_MEMO_CLASSES) {
         int k = ka * MIX_MEMO_CLASSES + kb;
@@ -1169,33 +1347,35 @@ static contact_guess guess_contact(const body_store *s, mix_memo *memo, const xf
             material_mix(s, a, b, 0, memo->mix[k]);
             memo->have[k] = 1;
         }
-        memcpy(g.material, memo->mix[k], sizeof g.material);
+        memcpy(g->material, memo->mix[k], sizeof g->material);
     } else {
-        material_mix(s, a, b, sub, g.material);
+        material_mix(s, a, b, sub, g->material);
     }
-    return g;
 }
 
 /* A contact's record bits, from its state and the reader's predictions. */
-static unsigned contact_bits(const contact *c, const contact_data *d, const contact_guess *gp, vec3 normal, vec3 cache_guess,
-                             xform rel, double reach, vec3 normal_a)
+SNAP_INLINE unsigned contact_bits(const contact *c, const contact_data *d, const contact_guess *gp, const vec3 *normal,
+                                  const vec3 *cache_guess, const xform *rel, double reach, const vec3 *normal_a)
 {
-    contact_guess g = *gp;
+    const double *mix = gp->material;
     int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
-    vec3 basis = basis_guess(c->cache.normal);
-    int tangent_guessed = !v3_is_zero(d->tangent1) && same_bits(&d->tangent1, &basis, sizeof basis);
+    int tangent_guessed = 0;
+    if (!v3_is_zero(d->tangent1)) { /* (the prediction's square root only where a basis is kept) */
+        vec3 basis = basis_guess(c->cache.normal);
+        tangent_guessed = same_bits(&d->tangent1, &basis, sizeof basis);
+    }
     return (unsigned)d->m.count | (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
                         (c->sub ? CREC_SUB : 0) | (c->sub_limit ? CREC_SUB_LIMIT : 0) | (c->cache.feature != -1 ? CREC_FEATURE : 0) |
                         (v3_is_zero(d->tangent1) ? 0 : tangent_guessed ? CREC_TANGENT_GUESS : CREC_TANGENT) |
-                        (v3_is_zero(normal) || d->m.count > 0 ? 0 : CREC_NORMAL) | /* (a manifold with points: always written) */
-                        (same_bits(&c->cache.normal, &cache_guess, sizeof cache_guess) ? 0 : CREC_CACHE_NORMAL) |
-                        (!c->slot || (f64_bits(d->friction) == f64_bits(g.material[0]) && f64_bits(d->restitution) == f64_bits(g.material[1]) &&
-                                    f64_bits(d->rolling_resistance) == f64_bits(g.material[2]))
+                        (v3_is_zero(*normal) || d->m.count > 0 ? 0 : CREC_NORMAL) | /* (a manifold with points: always written) */
+                        (same_bits(&c->cache.normal, cache_guess, sizeof *cache_guess) ? 0 : CREC_CACHE_NORMAL) |
+                        (!c->slot || (f64_bits(d->friction) == f64_bits(mix[0]) && f64_bits(d->restitution) == f64_bits(mix[1]) &&
+                                    f64_bits(d->rolling_resistance) == f64_bits(mix[2]))
                              ? 0 : CREC_MATERIAL) | /* (a pair without data has the bodies' mix) */
-                        (posed && !(same_bits(&c->rel_pose.p, &rel.p, sizeof rel.p) && same_bits(&c->rel_pose.q, &rel.q, sizeof rel.q))
+                        (posed && !(same_bits(&c->rel_pose.p, &rel->p, sizeof rel->p) && same_bits(&c->rel_pose.q, &rel->q, sizeof rel->q))
                              ? CREC_POSE : 0) |
                         ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
-                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, &normal_a, sizeof normal_a) ? CREC_NORMAL_A : 0);
+                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, normal_a, sizeof *normal_a) ? CREC_NORMAL_A : 0);
 }
 
 static void write_contacts(writer *o, const carom_world *w, const class_table *t)
@@ -1211,24 +1391,42 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         const contact_data *d = CONTACT_DATA(cs, i);
+        if (!c->slot && !(c->flags & IDLE_RECORD_FLAGS) && !c->sub && !c->sub_limit && v3_is_zero(c->cache.normal)) {
+            /* a broadphase pair without data (most of a settled pile's):
+             * what the general path below writes for it, without its
+             * predictions (slot 0 reads the empty record: no points, normal,
+             * basis or material; not posed) */
+            size_t at = o->pos;
+            unsigned bits = (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
+                            (c->cache.feature != -1 ? CREC_FEATURE : 0);
+            put_varint(o, zigzag((int64_t)c->id_a - last_a));
+            put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
+            last_a = c->id_a;
+            put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
+            if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
+            acct(o, SNAP_FIELD_contact_header, at);
+            continue;
+        }
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
-        contact_guess g = guess_contact(s, memo, s->collided, a, b, c->sub);
+        contact_guess g = {&s->collided[a], &s->collided[b], {0, 0, 0}};
+        if (c->slot) guess_material(s, memo, a, b, c->sub, &g);
         /* what the reader will hold, and predict from */
         vec3 normal = normal_is_state(c, d) ? d->m.normal : v3(0, 0, 0);
         vec3 cache_guess = c->cache.has_normal ? normal : v3(0, 0, 0);
         int posed = (c->flags & (CONTACT_REUSABLE | CONTACT_APART)) != 0;
-        xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
+        xform rel = posed ? relative_pose(*g.xa, *g.xb) : identity_pose;
         double reach = (c->flags & CONTACT_APART) ? body_reach(s, memo, b) : 0.0;
-        vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
-        unsigned bits = contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a);
+        vec3 normal_a = (c->flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa->q, normal) : normal;
+        unsigned bits = contact_bits(c, d, &g, &normal, &cache_guess, &rel, reach, &normal_a);
         /* every point where the reader predicts it (a settled pile's kept
          * manifolds): their positions and separations are not written */
-        reuse_motion m = reuse_guess(c, rel); /* (rel: B's collided pose in A's when posed) */
+        reuse_motion m;
+        reuse_guess(c, &rel, &m); /* (rel: B's collided pose in A's when posed) */
         int exact = d->m.count > 0;
         vec3 guess_point[MANIFOLD_MAX_POINTS];
         double guess_separation[MANIFOLD_MAX_POINTS];
         for (int k = 0; k < d->m.count; k++) {
-            point_guess(&m, d, g.xa, &d->state[k], &guess_point[k], &guess_separation[k]);
+            point_guess(&m, d, *g.xa, &d->state[k], &guess_point[k], &guess_separation[k]);
             exact = exact && same_bits(&guess_point[k], &d->m.points[k].point, sizeof(vec3)) &&
                     f64_bits(guess_separation[k]) == f64_bits(d->m.points[k].separation);
         }
@@ -1790,6 +1988,9 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
 {
     body_store *s = &w->bodies;
     contact_set *cs = &w->contacts;
+    contact_data scratch_data; /* (a slotless pair's record: see below) */
+    memset(&scratch_data, 0, sizeof scratch_data);
+    contact_data *scratch = &scratch_data;
     int last_a = 0;
     for (int i = 0; i < count && !r->failed; i++) {
         int a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 2 - last_a, 1, "contact body");
@@ -1812,9 +2013,27 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
         int ci = contact_append(cs, a, b, sub); /* (the pair map is built after the last, contact_set_index) */
-        if (ci < 0 || !contact_data_alloc(cs, ci)) return bad(r, "out of memory");
+        if (ci >= 0 && !(flags & IDLE_RECORD_FLAGS) && !(bits & ~(CREC_HAS_NORMAL | CREC_FLIP | CREC_FEATURE))) {
+            /* a pair without data, not posed, of the first manifold (the
+             * writer's short record): nothing more to read, and what the
+             * general path below would check holds (its bits are its cache's) */
+            contact *c = &cs->items[ci];
+            c->flags = flags;
+            c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
+            c->cache.flip = (bits & CREC_FLIP) != 0;
+            c->cache.feature = feature;
+            continue;
+        }
+        /* a pair whose record has no points, normal, basis or material of its
+         * own and no flag under which its data is read gets no data slot (it
+         * reads the empty record, as collision.c leaves such a pair): its
+         * record is read into scratch, which stays all zeros but for the
+         * material (most broadphase pairs of a settled pile) */
+        int keep = (flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING | CONTACT_REUSABLE)) ||
+                   (bits & (7 | CREC_NORMAL | CREC_TANGENT | CREC_TANGENT_GUESS | CREC_MATERIAL));
+        if (ci < 0 || (keep && !contact_data_alloc(cs, ci))) return bad(r, "out of memory");
         contact *c = &cs->items[ci];
-        contact_data *d = CONTACT_DATA(cs, ci);
+        contact_data *d = keep ? CONTACT_DATA(cs, ci) : scratch;
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
         if (sub) { /* the compound children a manifold number names must exist (its material is theirs); sub 0 names child 0 */
             int child_a, child_b;
@@ -1822,7 +2041,8 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             if ((child_a >= 0 && child_a >= s->shapes[sa].compound->count) || (child_b >= 0 && child_b >= s->shapes[sb].compound->count))
                 return bad(r, "contact %d: manifold %u names a compound child the bodies do not have", i, (unsigned)sub);
         }
-        contact_guess g = guess_contact(s, memo, s->collided, sa, sb, sub);
+        contact_guess g = {&s->collided[sa], &s->collided[sb], {0, 0, 0}};
+        if (keep) guess_material(s, memo, sa, sb, sub, &g);
         c->flags = flags;
         c->sub_limit = sub_limit;
         c->cache.has_normal = (bits & CREC_HAS_NORMAL) != 0;
@@ -1843,9 +2063,9 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         d->tangent1 = (bits & CREC_TANGENT)         ? get_coded_v3(r, basis_guess(c->cache.normal), "friction basis")
                       : (bits & CREC_TANGENT_GUESS) ? basis_guess(c->cache.normal) : v3(0, 0, 0);
         /* the predictions, as the writer made them */
-        xform rel = posed ? relative_pose(g.xa, g.xb) : g.xa;
+        xform rel = posed ? relative_pose(*g.xa, *g.xb) : identity_pose;
         double reach = (flags & CONTACT_APART) ? body_reach(s, memo, sb) : 0.0;
-        vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa.q, normal) : normal;
+        vec3 normal_a = (flags & CONTACT_REUSABLE) ? q_inv_rotate(g.xa->q, normal) : normal;
         if (posed) {
             c->rel_pose.p = (bits & CREC_POSE) ? get_coded_v3(r, rel.p, "contact pose") : rel.p;
             c->rel_pose.q = (bits & CREC_POSE) ? get_coded_q(r, rel.q, "contact pose") : rel.q;
@@ -1863,14 +2083,15 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
         if (posed && (!within_cube(c->rel_pose.p, 2 * RANGE_STATE_COORDINATE_MAX) ||
                       !(q_len(c->rel_pose.q) >= 0.5 && q_len(c->rel_pose.q) <= 2.0)))
             return bad(r, "contact %d: the pose is beyond 2e18 m or its rotation not near unit", i);
-        if ((contact_bits(c, d, &g, normal, cache_guess, rel, reach, normal_a) | (bits & CREC_EXACT)) != (unsigned)bits ||
+        if ((contact_bits(c, d, &g, &normal, &cache_guess, &rel, reach, &normal_a) | (bits & CREC_EXACT)) != (unsigned)bits ||
             ((bits & CREC_EXACT) && d->m.count == 0))
             return bad(r, "contact %d: its record bits do not match its fields", i);
         if (!(d->friction >= 0 && d->friction <= RANGE_FRICTION_MAX && d->restitution >= 0 && d->restitution <= 1 &&
               d->rolling_resistance >= 0 && d->rolling_resistance <= RANGE_FRICTION_MAX))
             return bad(r, "contact %d material out of range", i);
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
-        reuse_motion m = reuse_guess(c, rel);
+        reuse_motion m;
+        reuse_guess(c, &rel, &m);
         int inexact = 0;
         for (int k = 0; k < d->m.count && !r->failed; k++) {
             manifold_point *p = &d->m.points[k];
@@ -1886,7 +2107,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             st->tangent_impulse[1] = cur[6];
             vec3 point;
             double separation;
-            point_guess(&m, d, g.xa, st, &point, &separation);
+            point_guess(&m, d, *g.xa, st, &point, &separation);
             p->point = (bits & CREC_EXACT) ? point : get_coded_v3(r, point, "manifold point");
             p->separation = (bits & CREC_EXACT) ? separation : get_coded1(r, separation, "manifold point");
             if (!same_bits(&point, &p->point, sizeof point) || f64_bits(separation) != f64_bits(p->separation)) inexact = 1;
@@ -1906,7 +2127,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             return bad(r, "contact %d: its points are all as predicted but written", i);
         /* nothing a slotless pair would not read (collision.c): the slot goes
          * back, for the next contact */
-        if (!r->failed && contact_data_idle(cs, ci) && f64_bits(d->friction) == f64_bits(g.material[0]) &&
+        if (!r->failed && keep && contact_data_idle(cs, ci) && f64_bits(d->friction) == f64_bits(g.material[0]) &&
             f64_bits(d->restitution) == f64_bits(g.material[1]) && f64_bits(d->rolling_resistance) == f64_bits(g.material[2]))
             contact_data_release(cs, ci);
     }
