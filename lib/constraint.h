@@ -63,6 +63,7 @@ typedef struct contact_constraint {
      * velocities in their planes after each row (the wide ones in batches of
      * their own) */
     int locked;
+    int spinless;                /* neither body can turn (static or rotation-locked): no angular terms */
     vec3 n, t1, t2;
     double friction, restitution;
     double rolling;              /* rolling resistance (0: no rolling rows, the manifold may go wide) */

@@ -221,7 +221,8 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     s->delta_position[0] = v3_zero();
     s->delta_rotation[0] = v3_zero();
     s->body_slot[0] = -1;
-    int nb = 1, planar = 0;
+    int nb = 1;
+    uint32_t any_flags = 0;
     for (int i = 0; i < bs->count; i++) {
         if (bs->type[i] == CAROM_BODY_STATIC || !(bs->flags[i] & BODY_AWAKE)) continue;
         int k = nb++;
@@ -238,9 +239,10 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         s->delta_position[k] = v3_zero();
         s->delta_rotation[k] = v3_zero();
         body_step_of(bs, i, &bodies[k], ctx, &motion[k]);
-        planar |= (bs->flags[i] & BODY_LOCK_PLANE) != 0;
+        any_flags |= bs->flags[i];
     }
-    s->solver.planar = planar;
+    s->solver.planar = (any_flags & BODY_LOCK_PLANE) != 0;
+    s->solver.rotation_locked = (any_flags & BODY_LOCK_ROTATION) != 0;
     ctx->bodies = bodies;
     ctx->dp = s->delta_position;
     ctx->dq = s->delta_rotation;
@@ -369,6 +371,11 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
     c->locked = !w->scratch.solver.planar ? 0 :
                 (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
                 (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
+    /* neither body can turn (the static body 0, or rotation-locked: zero
+     * inverse inertia, w and dq stay zero): the wide passes drop the
+     * angular terms, which would only multiply zeros */
+    c->spinless = w->scratch.solver.rotation_locked && (c->a == 0 || (bs->flags[sa] & BODY_LOCK_ROTATION)) &&
+                  (c->b == 0 || (bs->flags[sb] & BODY_LOCK_ROTATION));
     c->an = NULL;
     c->r = NULL;
     c->spring = NULL;
@@ -693,7 +700,7 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
     if (!s->solver.wide_env) s->solver.wide_env = wide_read_env(); /* once per world, not a getenv a step */
     work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count,
-                           work->locked, ctx->body_count, s->solver.wide_env);
+                           work->locked > 0 || s->solver.rotation_locked, ctx->body_count, s->solver.wide_env);
     if (!work->wide) return 0;
     work->scalar_count = wide_overflow(work->wide, &work->scalar);
     return 1;

@@ -34,6 +34,7 @@ typedef struct solver_memory {
     int motion_capacity;
     int bodies_capacity;         /* step_scratch.bodies' (gather_bodies) */
     int planar;                  /* this step: some awake body is locked to a plane */
+    int rotation_locked;         /* this step: some awake body is rotation-locked (spinless manifolds may exist) */
 } solver_memory;
 void solver_memory_free(solver_memory *m);
 

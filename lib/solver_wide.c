@@ -7,8 +7,10 @@
  * the same number of points are packed four to a batch, field by field. Each
  * manifold is still solved point by point exactly as in solver.c; only the
  * order between manifolds becomes colour by colour. Manifolds with a
- * plane-locked body take batches of their own (after a colour's free ones),
- * whose passes keep the locked velocities in their planes. Manifolds beyond
+ * plane-locked body take batches of their own, whose passes keep the locked
+ * velocities in their planes, and so do manifolds whose bodies cannot turn
+ * (static or rotation-locked), whose passes solve only the linear terms
+ * (a switch that removes work saves it). Manifolds beyond
  * the last colour, or with rolling resistance, keep the scalar passes
  * (contact_solver.c). The AVX2 and SSE2 builds
  * of the passes come from one source (WIDE_PASSES below), each for two row
@@ -72,6 +74,17 @@ typedef struct wide_cpoint {
     lane_t ra[3], rb[3];         /* anchors from each centre, in the basis: (r.n, r.t1, r.t2) */
 } wide_cpoint;
 
+/* The point of a batch whose bodies cannot turn (each static or
+ * rotation-locked: zero inverse inertia and no spin), 64 bytes a point: the
+ * rows of wide_point without its 36 lanes of arms and their responses,
+ * which would only multiply zeros (the same bits, but for the sign of a
+ * zero). Both layouts take it for such batches: their rows are the same. */
+typedef struct wide_lpoint {
+    lane_t base_separation, normal_mass, normal_impulse;
+    lane_t total_normal_impulse;
+    lane_t tangent_mass[2], tangent_impulse[2];
+} wide_lpoint;
+
 /* A compact batch's inverse inertias in its basis e = (n, t1, t2), e_i.I^-1 e_j:
  * the upper triangle 00 01 02 11 12 22. */
 typedef struct wide_inertia {
@@ -89,6 +102,16 @@ typedef struct wide_lock {
     lane_t a[3], b[3];
 } wide_lock;
 
+/* A batch's kind, from its manifolds' bodies: whether a body is locked to a
+ * plane (the passes keep its velocity there) and whether none can turn (the
+ * rows are linear only: wide_lpoint). Each kind has its own batches within
+ * a colour and its own build of the warm-start and solve passes. */
+enum {
+    WIDE_KIND_LOCKED = 1,        /* a body is locked to a plane */
+    WIDE_KIND_SPINLESS = 2,      /* every body static or rotation-locked */
+    WIDE_KINDS = 4
+};
+
 typedef struct wide_batch {
     lane_t n[3], t1[3], t2[3];
     lane_t friction, bias_rate, mass_scale, impulse_scale;
@@ -99,12 +122,14 @@ typedef struct wide_batch {
     int lanes;                   /* lanes in use */
     int first;                   /* first of `count` wide points */
     int lock;                    /* its manifolds' plane normals in the set's locks, or -1: no body locked */
+    int kind;                    /* WIDE_KIND_* bits */
 } wide_batch;
 
 struct wide_set {
     wide_batch *batches;
     wide_point *points;
     wide_cpoint *cpoints;        /* the same block, compact: one or the other is used */
+    wide_lpoint *lpoints;        /* the spinless batches' points (either layout) */
     wide_inertia *inertia;       /* compact: per batch */
     int compact;                 /* the batches take the compact rows */
     wide_lock *locks;            /* locked batches' plane normals */
@@ -112,21 +137,20 @@ struct wide_set {
     double *deepest;             /* per batch: its deepest overlap (prepare) */
     int batch_count, overflow_count;
     int color_first[WIDE_COLORS + 1]; /* colour c's batches: color_first[c] .. color_first[c + 1] - 1 */
-    int color_locked[WIDE_COLORS];    /* colour c's locked batches: color_locked[c] .. color_first[c + 1] - 1 */
+    /* colour c's batches of kind k: kind_first[c][k] .. the next kind's first - 1 (the last kind's: color_first[c + 1] - 1) */
+    int kind_first[WIDE_COLORS][WIDE_KINDS];
     int avx2;                    /* run the AVX2 build of the passes */
-    int lock_kinds;              /* 2 when some manifold has a plane-locked body (buckets of their own), else 1 */
 };
 
 /* One build of the passes over the batches first .. last - 1 (WIDE_PASSES). */
 typedef struct wide_passes {
-    void (*prepare)(const wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm, int first,
-                    int last);
-    void (*warm)(const wide_set *ws, impulse_body *bodies, int first, int last);
-    void (*solve)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first, int last);
-    /* the same over locked batches */
-    void (*warm_locked)(const wide_set *ws, impulse_body *bodies, int first, int last);
-    void (*solve_locked)(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first,
-                         int last);
+    /* friction 0: no tangent rows are prepared or warm-started (their impulses stay zero) */
+    void (*prepare)(const wide_set *ws, contact_constraint *cc, const impulse_body *bodies, double warm, int friction,
+                    int first, int last);
+    /* per batch kind (WIDE_KIND_*) */
+    void (*warm[WIDE_KINDS])(const wide_set *ws, impulse_body *bodies, int friction, int first, int last);
+    void (*solve[WIDE_KINDS])(const wide_set *ws, const step_context *ctx, int use_bias, int hold_bounces, int first,
+                              int last);
 } wide_passes;
 
 /* Both row layouts' builds of the passes. */
@@ -150,7 +174,7 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
     if (wb->lock >= 0) {
         wide_lock *lk = &ws->locks[wb->lock];
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
-        if (ws->compact) { /* in the basis */
+        if (ws->compact && !(wb->kind & WIDE_KIND_SPINLESS)) { /* in the basis (spinless rows are solved in the world's) */
             la = v3(v3_dot(la, c->n), v3_dot(la, c->t1), v3_dot(la, c->t2));
             lb = v3(v3_dot(lb, c->n), v3_dot(lb, c->t1), v3_dot(lb, c->t2));
         }
@@ -166,30 +190,48 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
     wb->impulse_scale[l] = c->soft.impulse_scale;
 }
 
-/* Per colour, lock (1: a body is locked to a plane) and point count:
- * manifolds counted, then lanes filled, and the first batch. A bucket's
- * flat index is BUCKET(c, locked, n). */
-#define BUCKET(c, locked, n) (((c) * 2 + (locked)) * (MANIFOLD_MAX_POINTS + 1) + (n))
+/* A manifold's batch kind (WIDE_KIND_*). */
+static int kind_of(const contact_constraint *c)
+{
+    return (c->locked != 0 ? WIDE_KIND_LOCKED : 0) | (c->spinless ? WIDE_KIND_SPINLESS : 0);
+}
+
+/* Per colour, kind and point count: manifolds counted, then lanes filled,
+ * and the first batch. A bucket's flat index is BUCKET(c, kind, n). */
+#define BUCKET(c, kind, n) (((c) * WIDE_KINDS + (kind)) * (MANIFOLD_MAX_POINTS + 1) + (n))
 typedef struct plan_buckets {
-    int count[WIDE_COLORS * 2 * (MANIFOLD_MAX_POINTS + 1)];
-    int start[WIDE_COLORS * 2 * (MANIFOLD_MAX_POINTS + 1)];
+    int count[WIDE_COLORS * WIDE_KINDS * (MANIFOLD_MAX_POINTS + 1)];
+    int start[WIDE_COLORS * WIDE_KINDS * (MANIFOLD_MAX_POINTS + 1)];
 } plan_buckets;
+
+/* How many manifolds and points each kind has (wide_plan's first scan). */
+typedef struct plan_counts {
+    int manifolds[WIDE_KINDS], points[WIDE_KINDS];
+} plan_counts;
 
 /* The set, its batches and points and the planner's scratch in one block
  * (grown, never shrunk), 64-byte aligned. */
-static wide_set *reserve_set(void **mem, size_t *capacity, int npoints, int compact, int ncon, int nlocked,
-                             int nb, int **color, uint32_t **used)
+static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc, int compact, int ncon, int nb,
+                             int **color, uint32_t **used)
 {
-    /* upper bounds: every (colour, point count) bucket may end in a part-full batch */
+    /* upper bounds: every (colour, kind, point count) bucket may end in a part-full batch */
     size_t point_size = compact ? sizeof(wide_cpoint) : sizeof(wide_point);
-    int buckets = nlocked ? 2 : 1; /* locked manifolds have buckets of their own */
-    int max_batches = ncon / LANES + buckets * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
-    int max_locks = nlocked ? nlocked / LANES + WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
-    int max_wide_points = npoints / LANES + buckets * WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
+    int kinds = 0, turning_kinds = 0, spinless_kinds = 0, nturning = 0, nspinless = 0, nlocked = 0, locked_kinds = 0;
+    for (int k = 0; k < WIDE_KINDS; k++) {
+        if (!pc->manifolds[k]) continue;
+        kinds++;
+        if (k & WIDE_KIND_SPINLESS) { spinless_kinds++; nspinless += pc->points[k]; }
+        else { turning_kinds++; nturning += pc->points[k]; }
+        if (k & WIDE_KIND_LOCKED) { locked_kinds++; nlocked += pc->manifolds[k]; }
+    }
+    int max_batches = ncon / LANES + kinds * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
+    int max_locks = nlocked ? nlocked / LANES + locked_kinds * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
+    int max_wide_points = nturning / LANES + turning_kinds * WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
+    int max_lpoints = nspinless ? nspinless / LANES + spinless_kinds * WIDE_COLORS * (1 + 2 + 3 + 4) + 1 : 0;
     size_t inertia_bytes = compact ? align_up(sizeof(wide_inertia) * (size_t)max_batches) : 0;
     size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
-                   align_up(point_size * (size_t)max_wide_points) + align_up(sizeof(wide_lock) * (size_t)max_locks) +
-                   inertia_bytes +
+                   align_up(point_size * (size_t)max_wide_points) + align_up(sizeof(wide_lpoint) * (size_t)max_lpoints) +
+                   align_up(sizeof(wide_lock) * (size_t)max_locks) + inertia_bytes +
                    align_up(sizeof(int) * (size_t)ncon) * 2 +
                    align_up(sizeof(uint32_t) * (size_t)nb) + align_up(sizeof(double) * (size_t)max_batches);
     if (bytes > *capacity) {
@@ -202,7 +244,6 @@ static wide_set *reserve_set(void **mem, size_t *capacity, int npoints, int comp
     }
     char *base = (char *)(((uintptr_t)*mem + 63) & ~(uintptr_t)63);
     wide_set *ws = (wide_set *)base;
-    ws->lock_kinds = buckets;
     ws->compact = compact;
     base += align_up(sizeof *ws);
     ws->batches = (wide_batch *)base;
@@ -210,6 +251,8 @@ static wide_set *reserve_set(void **mem, size_t *capacity, int npoints, int comp
     ws->points = (wide_point *)base;
     ws->cpoints = (wide_cpoint *)base;
     base += align_up(point_size * (size_t)max_wide_points);
+    ws->lpoints = (wide_lpoint *)base;
+    base += align_up(sizeof(wide_lpoint) * (size_t)max_lpoints);
     ws->inertia = compact ? (wide_inertia *)base : NULL;
     base += inertia_bytes;
     ws->locks = (wide_lock *)base;
@@ -227,7 +270,7 @@ static wide_set *reserve_set(void **mem, size_t *capacity, int npoints, int comp
 
 /* Greedy colouring; the static body 0 never blocks (it does not move).
  * bucket[k]: constraint k's bucket (BUCKET), or -1: the scalar passes. */
-static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int *bucket, uint32_t *used,
+static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int kinds, int *bucket, uint32_t *used,
                             plan_buckets *pb)
 {
     memset(pb->count, 0, sizeof pb->count);
@@ -245,30 +288,35 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
         }
         if (a) used[a] |= 1u << c;
         if (b) used[b] |= 1u << c;
-        bucket[k] = BUCKET(c, cc[k].locked != 0, cc[k].count);
+        bucket[k] = BUCKET(c, kinds ? kind_of(&cc[k]) : 0, cc[k].count);
         pb->count[bucket[k]]++;
     }
 }
 
-/* Batches in colour order; inside a colour, by point count. */
-static void lay_out_batches(wide_set *ws, plan_buckets *pb)
+/* Batches in colour order; inside a colour, by kind, then point count. */
+static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *pc)
 {
-    int nbatch = 0, nwide = 0, nlock = 0;
+    int nbatch = 0, nwide = 0, nlin = 0, nlock = 0;
     for (int c = 0; c < WIDE_COLORS; c++) {
         ws->color_first[c] = nbatch;
-        for (int locked = 0; locked < ws->lock_kinds; locked++) {
-            if (locked) ws->color_locked[c] = nbatch;
+        for (int kind = 0; kind < WIDE_KINDS; kind++) {
+            ws->kind_first[c][kind] = nbatch;
+            if (!pc->manifolds[kind]) continue; /* no bucket of this kind has any */
+            int spinless = (kind & WIDE_KIND_SPINLESS) != 0;
             for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
-                int bk = BUCKET(c, locked, n);
+                int bk = BUCKET(c, kind, n);
                 pb->start[bk] = nbatch;
                 int batches = (pb->count[bk] + LANES - 1) / LANES;
+                int next = spinless ? nlin : nwide;
                 for (int i = 0; i < batches; i++) {
                     wide_batch *wb = &ws->batches[nbatch + i];
-                    int first = nwide + i * n;
+                    int first = next + i * n;
                     if (i == batches - 1 && pb->count[bk] % LANES) {
                         /* the part-full batch: empty lanes stay zero (no mass, no effect) */
                         memset(wb, 0, sizeof *wb);
-                        if (ws->compact) {
+                        if (spinless) {
+                            memset(&ws->lpoints[first], 0, sizeof(wide_lpoint) * (size_t)n);
+                        } else if (ws->compact) {
                             memset(&ws->cpoints[first], 0, sizeof(wide_cpoint) * (size_t)n);
                             memset(&ws->inertia[nbatch + i], 0, sizeof(wide_inertia));
                         } else {
@@ -277,18 +325,19 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb)
                     }
                     wb->count = n;
                     wb->first = first;
+                    wb->kind = kind;
                     wb->lock = -1;
-                    if (locked) {
+                    if (kind & WIDE_KIND_LOCKED) {
                         wb->lock = nlock;
                         memset(&ws->locks[nlock++], 0, sizeof(wide_lock));
                     }
                 }
                 nbatch += batches;
-                nwide += batches * n;
+                if (spinless) nlin += batches * n;
+                else nwide += batches * n;
                 pb->count[bk] = 0; /* now: lanes filled so far */
             }
         }
-        if (ws->lock_kinds == 1) ws->color_locked[c] = nbatch; /* none locked */
     }
     ws->color_first[WIDE_COLORS] = nbatch;
     ws->batch_count = nbatch;
@@ -317,18 +366,31 @@ int wide_read_env(void)
     return env;
 }
 
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb, int env)
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env)
 {
     int *color;
     uint32_t *used;
     int npoints = 0;
-    for (int k = 0; k < ncon; k++) npoints += cc[k].count;
+    plan_counts pc;
+    memset(&pc, 0, sizeof pc);
+    if (kinds) {
+        for (int k = 0; k < ncon; k++) {
+            int kind = kind_of(&cc[k]);
+            pc.manifolds[kind]++;
+            pc.points[kind] += cc[k].count;
+        }
+        for (int kind = 0; kind < WIDE_KINDS; kind++) npoints += pc.points[kind];
+    } else {
+        for (int k = 0; k < ncon; k++) npoints += cc[k].count;
+        pc.manifolds[0] = ncon;
+        pc.points[0] = npoints;
+    }
     int compact = env & WIDE_ENV_COMPACT ? 1 : env & WIDE_ENV_FULL ? 0 : npoints >= WIDE_COMPACT_POINTS;
-    wide_set *ws = reserve_set(mem, capacity, npoints, compact, ncon, nlocked, nb, &color, &used);
+    wide_set *ws = reserve_set(mem, capacity, &pc, compact, ncon, nb, &color, &used);
     if (!ws) return NULL;
     plan_buckets pb;
-    color_manifolds(ws, cc, ncon, color, used, &pb);
-    lay_out_batches(ws, &pb);
+    color_manifolds(ws, cc, ncon, kinds, color, used, &pb);
+    lay_out_batches(ws, &pb, &pc);
     fill_lanes(ws, cc, ncon, color, &pb);
 #if WIDE_AVX2
     /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
@@ -411,8 +473,10 @@ LANE_INLINE void scatter(const wide_batch *wb, impulse_body *bodies, const lane_
 /* `locked` (a constant in each inlined copy): the batch's manifolds have
  * plane-locked bodies (lk their normals), whose velocities are kept in their
  * planes after every row, as the scalar passes do. */
+/* friction 0: the tangent impulses are zero and their rows were not
+ * prepared (the terms they would add are zeros). */
 LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body *bodies, const wide_lock *lk,
-                            const int locked)
+                            const int locked, const int friction)
 {
     lane_bodies lb;
     gather(wb, bodies, &lb);
@@ -420,12 +484,22 @@ LANE_INLINE void warm_batch(const wide_batch *wb, wide_point *pts, impulse_body 
         wide_point *p = &pts[i];
         lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
         p->total_normal_impulse += ni;
-        for (int d = 0; d < 3; d++) {
-            lane_t P = wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2;
-            lb.va[d] -= lb.ma * P;
-            lb.vb[d] += lb.mb * P;
-            lb.wa[d] -= p->ia_n[d] * ni + p->ia_t[0][d] * t1 + p->ia_t[1][d] * t2;
-            lb.wb[d] += p->ib_n[d] * ni + p->ib_t[0][d] * t1 + p->ib_t[1][d] * t2;
+        if (friction) {
+            for (int d = 0; d < 3; d++) {
+                lane_t P = wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2;
+                lb.va[d] -= lb.ma * P;
+                lb.vb[d] += lb.mb * P;
+                lb.wa[d] -= p->ia_n[d] * ni + p->ia_t[0][d] * t1 + p->ia_t[1][d] * t2;
+                lb.wb[d] += p->ib_n[d] * ni + p->ib_t[0][d] * t1 + p->ib_t[1][d] * t2;
+            }
+        } else {
+            for (int d = 0; d < 3; d++) {
+                lane_t P = wb->n[d] * ni;
+                lb.va[d] -= lb.ma * P;
+                lb.vb[d] += lb.mb * P;
+                lb.wa[d] -= p->ia_n[d] * ni;
+                lb.wb[d] += p->ib_n[d] * ni;
+            }
         }
         if (locked) {
             KEEP_IN_PLANE(lb.va, lk->a);
@@ -570,6 +644,179 @@ LANE_INLINE void solve_batch(const wide_batch *wb, wide_point *pts, const step_c
     scatter(wb, ctx->bodies, &lb);
 }
 
+/* ---- the spinless rows (wide_lpoint) --------------------------------------
+ * A batch whose bodies cannot turn: the rows above with every angular term
+ * dropped. Each was a product with a zero inverse inertia, angular velocity
+ * or rotation (a rotation-locked body keeps w = 0 and dq = 0, the static
+ * body 0 has both zero), so the results are the same bits but for the sign
+ * of a zero, and only the linear velocities are gathered and scattered. */
+
+/* The lanes' linear velocities and inverse masses. */
+typedef struct lane_lbodies {
+    lane_t va[3], vb[3];
+    lane_t ma, mb;
+} lane_lbodies;
+
+LANE_INLINE void gather_l(const wide_batch *wb, const impulse_body *bodies, lane_lbodies *lb)
+{
+    const impulse_body *A0 = &bodies[wb->a[0]], *A1 = &bodies[wb->a[1]], *A2 = &bodies[wb->a[2]], *A3 = &bodies[wb->a[3]];
+    const impulse_body *B0 = &bodies[wb->b[0]], *B1 = &bodies[wb->b[1]], *B2 = &bodies[wb->b[2]], *B3 = &bodies[wb->b[3]];
+    SET_LANES(lb->va[0], A0, A1, A2, A3, v.x);
+    SET_LANES(lb->va[1], A0, A1, A2, A3, v.y);
+    SET_LANES(lb->va[2], A0, A1, A2, A3, v.z);
+    SET_LANES(lb->vb[0], B0, B1, B2, B3, v.x);
+    SET_LANES(lb->vb[1], B0, B1, B2, B3, v.y);
+    SET_LANES(lb->vb[2], B0, B1, B2, B3, v.z);
+    SET_LANES(lb->ma, A0, A1, A2, A3, inv_mass);
+    SET_LANES(lb->mb, B0, B1, B2, B3, inv_mass);
+}
+
+LANE_INLINE void scatter_l(const wide_batch *wb, impulse_body *bodies, const lane_lbodies *lb)
+{
+    for (int l = 0; l < LANES; l++) {
+        if (wb->a[l]) bodies[wb->a[l]].v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
+        if (wb->b[l]) bodies[wb->b[l]].v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
+    }
+}
+
+LANE_INLINE void warm_batch_l(const wide_batch *wb, wide_lpoint *pts, impulse_body *bodies, const wide_lock *lk,
+                              const int locked, const int friction)
+{
+    lane_lbodies lb;
+    gather_l(wb, bodies, &lb);
+    for (int i = 0; i < wb->count; i++) {
+        wide_lpoint *p = &pts[i];
+        lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
+        p->total_normal_impulse += ni;
+        for (int d = 0; d < 3; d++) {
+            lane_t P = friction ? wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2 : wb->n[d] * ni;
+            lb.va[d] -= lb.ma * P;
+            lb.vb[d] += lb.mb * P;
+        }
+        if (locked) {
+            KEEP_IN_PLANE(lb.va, lk->a);
+            KEEP_IN_PLANE(lb.vb, lk->b);
+        }
+    }
+    scatter_l(wb, bodies, &lb);
+}
+
+/* The lanes' relative translation since the sub-steps began (B minus A). */
+LANE_INLINE void gather_translation(const wide_batch *wb, const step_context *ctx, lane_t dp[3])
+{
+    const vec3 *pa0 = &ctx->dp[wb->a[0]], *pa1 = &ctx->dp[wb->a[1]], *pa2 = &ctx->dp[wb->a[2]], *pa3 = &ctx->dp[wb->a[3]];
+    const vec3 *pb0 = &ctx->dp[wb->b[0]], *pb1 = &ctx->dp[wb->b[1]], *pb2 = &ctx->dp[wb->b[2]], *pb3 = &ctx->dp[wb->b[3]];
+    lane_t dpa[3];
+    SET_LANES(dpa[0], pa0, pa1, pa2, pa3, x);
+    SET_LANES(dpa[1], pa0, pa1, pa2, pa3, y);
+    SET_LANES(dpa[2], pa0, pa1, pa2, pa3, z);
+    SET_LANES(dp[0], pb0, pb1, pb2, pb3, x);
+    SET_LANES(dp[1], pb0, pb1, pb2, pb3, y);
+    SET_LANES(dp[2], pb0, pb1, pb2, pb3, z);
+    for (int d = 0; d < 3; d++) dp[d] -= dpa[d];
+}
+
+LANE_INLINE void solve_normal_rows_l(const wide_batch *wb, wide_lpoint *pts, const step_context *ctx,
+                                     lane_lbodies *lb, int use_bias, int hold_bounces, const wide_lock *lk,
+                                     const int locked)
+{
+    lane_t dp[3];
+    gather_translation(wb, ctx, dp);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(ctx->inv_h), push = SPLAT(-ctx->push_max);
+    lane_t pen_mass_scale = one, pen_impulse_scale = zero;
+    int soft = use_bias && ctx->correction == CAROM_CORRECTION_SOFT;
+    int baumgarte = use_bias && ctx->correction == CAROM_CORRECTION_BAUMGARTE;
+    if (soft) {
+        pen_mass_scale = wb->mass_scale;
+        pen_impulse_scale = wb->impulse_scale;
+    }
+    const lane_t baum_rate = SPLAT(ctx->baumgarte_rate), slop = SPLAT(ctx->slop);
+    lane_t dpn = DOT3(wb->n, dp); /* the same for every point: nothing turns */
+    for (int i = 0; i < wb->count; i++) {
+        wide_lpoint *p = &pts[i];
+        lane_t s = p->base_separation + dpn;
+        lane_t pen_bias = zero;
+        if (soft || baumgarte) {
+            lane_t rate = wb->bias_rate;
+            pen_bias = CONTACT_PUSH_BIAS(soft, s, rate, baum_rate, slop, push, zero, LANE_MAX, LANE_MIN);
+        }
+        lane_mask ahead = s > zero;
+        lane_t spec = CONTACT_SPECULATIVE_BIAS(s, inv_h);
+        lane_t bias = SELECT_LANES(ahead, spec, pen_bias);
+        lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
+        lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
+        lane_t vn = wb->n[0] * (lb->vb[0] - lb->va[0]) + wb->n[1] * (lb->vb[1] - lb->va[1]) +
+                    wb->n[2] * (lb->vb[2] - lb->va[2]);
+        lane_t old = p->normal_impulse;
+        lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
+        total = LANE_MAX(total, zero);
+        if (hold_bounces) {
+            lane_mask hold = ahead & (wb->restitution > zero);
+            total = SELECT_LANES(hold, LANE_MIN(total, old), total);
+        }
+        lane_t lambda = total - old;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        lane_t la = lb->ma * lambda, lbm = lb->mb * lambda;
+        for (int d = 0; d < 3; d++) {
+            lb->va[d] -= la * wb->n[d];
+            lb->vb[d] += lbm * wb->n[d];
+        }
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
+    }
+}
+
+LANE_INLINE void solve_friction_rows_l(const wide_batch *wb, wide_lpoint *pts, lane_lbodies *lb, const wide_lock *lk,
+                                       const int locked)
+{
+    for (int i = 0; i < wb->count; i++) {
+        wide_lpoint *p = &pts[i];
+        lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
+        lane_t v1 = DOT3(dv, wb->t1);
+        lane_t v2 = DOT3(dv, wb->t2);
+        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
+        lane_t limit = wb->friction * p->normal_impulse;
+        lane_t mag2 = n1 * n1 + n2 * n2;
+        lane_mask over = mag2 > limit * limit;
+        if (over[0] | over[1] | over[2] | over[3]) {
+            for (int l = 0; l < LANES; l++) {
+                if (!over[l]) continue;
+                double s1 = n1[l], s2 = n2[l];
+                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
+                                  limit[l]);
+                n1[l] = s1;
+                n2[l] = s2;
+            }
+        }
+        p->tangent_impulse[0] = n1;
+        p->tangent_impulse[1] = n2;
+        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        for (int d = 0; d < 3; d++) {
+            lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
+            lb->va[d] -= lb->ma * P;
+            lb->vb[d] += lb->mb * P;
+        }
+        if (locked) {
+            KEEP_IN_PLANE(lb->va, lk->a);
+            KEEP_IN_PLANE(lb->vb, lk->b);
+        }
+    }
+}
+
+LANE_INLINE void solve_batch_l(const wide_batch *wb, wide_lpoint *pts, const step_context *ctx, int use_bias,
+                               int hold_bounces, const wide_lock *lk, const int locked)
+{
+    lane_lbodies lb;
+    gather_l(wb, ctx->bodies, &lb);
+    solve_normal_rows_l(wb, pts, ctx, &lb, use_bias, hold_bounces, lk, locked);
+    if (ctx->friction) solve_friction_rows_l(wb, pts, &lb, lk, locked);
+    scatter_l(wb, ctx->bodies, &lb);
+}
+
 /* Lane l of a batch reads manifold l (an empty lane reads zeros: static body,
  * no point, no impulse, so every row it gets is zero). */
 typedef struct lane_source {
@@ -619,8 +866,9 @@ typedef struct lane_manifolds {
     lane_t ia[3][3], ib[3][3], va[3], wa[3], vb[3], wb[3], ma, mb, center_a[3], center_b[3];
 } lane_manifolds;
 
+/* spin 0 (a spinless batch): the inertias and angular velocities are not gathered (not read). */
 LANE_INLINE void gather_manifolds(const wide_batch *wb, contact_constraint *cc, const impulse_body *bodies,
-                                  lane_manifolds *lm)
+                                  lane_manifolds *lm, const int spin)
 {
     const impulse_body *A[LANES], *B[LANES];
     vec3 ca[LANES], cb[LANES];
@@ -631,12 +879,14 @@ LANE_INLINE void gather_manifolds(const wide_batch *wb, contact_constraint *cc, 
         ca[l] = lm->c[l] ? lm->c[l]->center_a : v3_zero();
         cb[l] = lm->c[l] ? lm->c[l]->center_b : v3_zero();
     }
-    gather_inertia(lm->ia, A[0], A[1], A[2], A[3]);
-    gather_inertia(lm->ib, B[0], B[1], B[2], B[3]);
+    if (spin) {
+        gather_inertia(lm->ia, A[0], A[1], A[2], A[3]);
+        gather_inertia(lm->ib, B[0], B[1], B[2], B[3]);
+        gather_vec(lm->wa, A[0]->w, A[1]->w, A[2]->w, A[3]->w);
+        gather_vec(lm->wb, B[0]->w, B[1]->w, B[2]->w, B[3]->w);
+    }
     gather_vec(lm->va, A[0]->v, A[1]->v, A[2]->v, A[3]->v);
-    gather_vec(lm->wa, A[0]->w, A[1]->w, A[2]->w, A[3]->w);
     gather_vec(lm->vb, B[0]->v, B[1]->v, B[2]->v, B[3]->v);
-    gather_vec(lm->wb, B[0]->w, B[1]->w, B[2]->w, B[3]->w);
     SET_LANES(lm->ma, A[0], A[1], A[2], A[3], inv_mass);
     SET_LANES(lm->mb, B[0], B[1], B[2], B[3], inv_mass);
     gather_vec(lm->center_a, ca[0], ca[1], ca[2], ca[3]);
@@ -668,13 +918,19 @@ LANE_INLINE void gather_point(const lane_manifolds *lm, int i, const contact_poi
 }
 
 LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wide_point *p, const lane_t ra[3],
-                              const lane_t rb[3], const lane_t lin[3])
+                              const lane_t rb[3], const lane_t lin[3], int friction)
 {
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
     CROSS(p->ra_n, ra, wb->n);
     CROSS(p->rb_n, rb, wb->n);
     MAT_VEC(p->ia_n, lm->ia, p->ra_n);
     MAT_VEC(p->ib_n, lm->ib, p->rb_n);
+    if (!friction) { /* no tangent rows: only the normal's mass */
+        lane_t kn = lin[0] + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
+        lane_t ikn = one / SELECT_LANES(kn > zero, kn, one);
+        p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
+        return;
+    }
     CROSS(p->ra_t[0], ra, wb->t1);
     CROSS(p->rb_t[0], rb, wb->t1);
     CROSS(p->ra_t[1], ra, wb->t2);
@@ -694,18 +950,26 @@ LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wi
 }
 
 /* Point i's warm-start impulses, scaled by warm (empty lanes read zeros). */
-LANE_INLINE void warm_point(wide_point *p, const contact_point_state *const st[LANES], double warm)
-{
-    const lane_t zero = SPLAT(0.0), warm_scale = SPLAT(warm);
-    lane_t ni, t1, t2;
-    SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
-    SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
-    SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
-    p->normal_impulse = warm_scale * ni;
-    p->tangent_impulse[0] = warm_scale * t1;
-    p->tangent_impulse[1] = warm_scale * t2;
-    p->total_normal_impulse = zero;
-}
+/* Written over the three point types (their impulse fields share names):
+ * friction 0 starts the tangent impulses at zero (a world whose friction was
+ * switched off no longer pushes with last step's). */
+#define WARM_POINT(p, st, warm, friction)                                           \
+    do {                                                                            \
+        const lane_t zero_ = SPLAT(0.0), warm_scale_ = SPLAT(warm);                 \
+        lane_t ni_;                                                                 \
+        SET_LANES(ni_, st[0], st[1], st[2], st[3], normal_impulse);                 \
+        (p)->normal_impulse = warm_scale_ * ni_;                                    \
+        (p)->total_normal_impulse = zero_;                                          \
+        if (friction) {                                                             \
+            lane_t t1_, t2_;                                                        \
+            SET_LANES(t1_, st[0], st[1], st[2], st[3], tangent_impulse[0]);         \
+            SET_LANES(t2_, st[0], st[1], st[2], st[3], tangent_impulse[1]);         \
+            (p)->tangent_impulse[0] = warm_scale_ * t1_;                            \
+            (p)->tangent_impulse[1] = warm_scale_ * t2_;                            \
+        } else {                                                                    \
+            (p)->tangent_impulse[0] = (p)->tangent_impulse[1] = zero_;              \
+        }                                                                           \
+    } while (0)
 
 /* What the stages around the passes read of point i in each lane's
  * constraint (the shock pass, restitution, the events); returns the deepest
@@ -736,10 +1000,10 @@ LANE_INLINE double store_point(const wide_batch *wb, const lane_manifolds *lm, i
 #define LOCKED_INV_MASS(m, d, l) ((m) * (one - DOT3(d, l) * DOT3(d, l)))
 
 LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_constraint *cc,
-                                 const impulse_body *bodies, double warm, const wide_lock *lk)
+                                 const impulse_body *bodies, double warm, const wide_lock *lk, int friction)
 {
     lane_manifolds lm;
-    gather_manifolds(wb, cc, bodies, &lm);
+    gather_manifolds(wb, cc, bodies, &lm, 1);
     /* the linear share of each row's inverse effective mass (n, t1, t2) */
     lane_t lin[3];
     lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
@@ -755,7 +1019,7 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
         const contact_point_state *st[LANES];
         lane_t ra[3], rb[3], sep;
         gather_point(&lm, i, st, ra, rb, &sep);
-        prepare_rows(wb, &lm, p, ra, rb, lin);
+        prepare_rows(wb, &lm, p, ra, rb, lin, friction);
         p->base_separation = sep;
         /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
         lane_t wxa[3], wxb[3];
@@ -764,7 +1028,49 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
         lane_t vrel[3];
         for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
         lane_t vn = DOT3(vrel, wb->n);
-        warm_point(p, st, warm);
+        WARM_POINT(p, st, warm, friction);
+        deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
+    }
+    return deepest;
+}
+
+/* The effective mass 1 / k of a row, 0 where k is not positive. */
+#define ROW_MASS(k) SELECT_LANES((k) > zero, one / SELECT_LANES((k) > zero, (k), one), zero)
+
+/* A spinless batch's points: each row's mass is its linear share alone
+ * (the angular ones were zeros), the same at every point of a manifold. */
+LANE_INLINE double prepare_batch_l(const wide_batch *wb, wide_lpoint *pts, contact_constraint *cc,
+                                   const impulse_body *bodies, double warm, const wide_lock *lk, int friction)
+{
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
+    lane_manifolds lm;
+    gather_manifolds(wb, cc, bodies, &lm, 0);
+    lane_t lin[3];
+    lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
+    if (lk) {
+        lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, lk->a) + LOCKED_INV_MASS(lm.mb, wb->n, lk->b);
+        lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t1, lk->b);
+        lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t2, lk->b);
+    }
+    lane_t normal_mass = ROW_MASS(lin[0]), tangent_mass[2] = {zero, zero};
+    if (friction) {
+        tangent_mass[0] = ROW_MASS(lin[1]);
+        tangent_mass[1] = ROW_MASS(lin[2]);
+    }
+    lane_t dv[3];
+    for (int d = 0; d < 3; d++) dv[d] = lm.vb[d] - lm.va[d];
+    lane_t vn = DOT3(dv, wb->n); /* normal velocity before solving, at every point */
+    double deepest = 0.0;
+    for (int i = 0; i < wb->count; i++) {
+        wide_lpoint *p = &pts[i];
+        const contact_point_state *st[LANES];
+        lane_t ra[3], rb[3], sep;
+        gather_point(&lm, i, st, ra, rb, &sep);
+        p->normal_mass = normal_mass;
+        p->tangent_mass[0] = tangent_mass[0];
+        p->tangent_mass[1] = tangent_mass[1];
+        p->base_separation = sep;
+        WARM_POINT(p, st, warm, friction);
         deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
     }
     return deepest;
@@ -844,7 +1150,7 @@ LANE_INLINE void scatter_c(const wide_batch *wb, impulse_body *bodies, lane_cbod
     } while (0)
 
 LANE_INLINE void warm_batch_c(const wide_batch *wb, const wide_inertia *in, wide_cpoint *pts, impulse_body *bodies,
-                              const wide_lock *lk, const int locked)
+                              const wide_lock *lk, const int locked, const int friction)
 {
     lane_cbodies lb;
     const lane_t zero = SPLAT(0.0);
@@ -854,19 +1160,23 @@ LANE_INLINE void warm_batch_c(const wide_batch *wb, const wide_inertia *in, wide
         lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
         p->total_normal_impulse += ni;
         lb.va[0] -= lb.ma * ni;
-        lb.va[1] -= lb.ma * t1;
-        lb.va[2] -= lb.ma * t2;
         lb.vb[0] += lb.mb * ni;
-        lb.vb[1] += lb.mb * t1;
-        lb.vb[2] += lb.mb * t2;
-        PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, t1, t2);
-        PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, t1, t2);
+        if (friction) {
+            lb.va[1] -= lb.ma * t1;
+            lb.va[2] -= lb.ma * t2;
+            lb.vb[1] += lb.mb * t1;
+            lb.vb[2] += lb.mb * t2;
+            PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, t1, t2);
+            PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, t1, t2);
+        } else {
+            PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, zero, zero);
+            PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, zero, zero);
+        }
         if (locked) {
             KEEP_IN_PLANE(lb.va, lk->a);
             KEEP_IN_PLANE(lb.vb, lk->b);
         }
     }
-    (void)zero;
     scatter_c(wb, bodies, &lb);
 }
 
@@ -1001,28 +1311,13 @@ LANE_INLINE void project_inertia(lane_t k[6], const wide_batch *wb, lane_t ia[3]
     k[5] = DOT3(wb->t2, it2);
 }
 
-LANE_INLINE void warm_cpoint(wide_cpoint *p, const contact_point_state *const st[LANES], double warm)
-{
-    const lane_t zero = SPLAT(0.0), warm_scale = SPLAT(warm);
-    lane_t ni, t1, t2;
-    SET_LANES(ni, st[0], st[1], st[2], st[3], normal_impulse);
-    SET_LANES(t1, st[0], st[1], st[2], st[3], tangent_impulse[0]);
-    SET_LANES(t2, st[0], st[1], st[2], st[3], tangent_impulse[1]);
-    p->normal_impulse = warm_scale * ni;
-    p->tangent_impulse[0] = warm_scale * t1;
-    p->tangent_impulse[1] = warm_scale * t2;
-    p->total_normal_impulse = zero;
-}
-
-/* The effective mass 1 / k of a row, 0 where k is not positive. */
-#define ROW_MASS(k) SELECT_LANES((k) > zero, one / SELECT_LANES((k) > zero, (k), one), zero)
 
 LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_cpoint *pts, contact_constraint *cc,
-                                   const impulse_body *bodies, double warm, const wide_lock *lk)
+                                   const impulse_body *bodies, double warm, const wide_lock *lk, int friction)
 {
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
     lane_manifolds lm;
-    gather_manifolds(wb, cc, bodies, &lm);
+    gather_manifolds(wb, cc, bodies, &lm, 1);
     project_inertia(in->ka, wb, lm.ia);
     project_inertia(in->kb, wb, lm.ib);
     /* the linear share of each row's inverse effective mass (n, t1, t2);
@@ -1046,16 +1341,19 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
         lane_t jan[3] = {zero, a[2], -a[1]}, jbn[3] = {zero, b[2], -b[1]};
         lane_t ja1[3] = {-a[2], zero, a[0]}, jb1[3] = {-b[2], zero, b[0]};
         lane_t ja2[3] = {a[1], -a[0], zero}, jb2[3] = {b[1], -b[0], zero};
-        lane_t kn = lin[0], k1 = lin[1], k2 = lin[2];
+        lane_t kn = lin[0];
         ADD_QUAD(kn, in->ka, jan);
         ADD_QUAD(kn, in->kb, jbn);
-        ADD_QUAD(k1, in->ka, ja1);
-        ADD_QUAD(k1, in->kb, jb1);
-        ADD_QUAD(k2, in->ka, ja2);
-        ADD_QUAD(k2, in->kb, jb2);
         p->normal_mass = ROW_MASS(kn);
-        p->tangent_mass[0] = ROW_MASS(k1);
-        p->tangent_mass[1] = ROW_MASS(k2);
+        if (friction) {
+            lane_t k1 = lin[1], k2 = lin[2];
+            ADD_QUAD(k1, in->ka, ja1);
+            ADD_QUAD(k1, in->kb, jb1);
+            ADD_QUAD(k2, in->ka, ja2);
+            ADD_QUAD(k2, in->kb, jb2);
+            p->tangent_mass[0] = ROW_MASS(k1);
+            p->tangent_mass[1] = ROW_MASS(k2);
+        }
         p->base_separation = sep;
         lane_t wxa[3], wxb[3];
         CROSS(wxa, lm.wa, ra);
@@ -1063,7 +1361,7 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
         lane_t vrel[3];
         for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
         lane_t vn = DOT3(vrel, wb->n);
-        warm_cpoint(p, st, warm);
+        WARM_POINT(p, st, warm, friction);
         deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
     }
     return deepest;
@@ -1075,28 +1373,55 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
  * the same in both builds, so results do not depend on the machine. */
 #define WIDE_PASSES(SUFFIX, TARGET)                                                                     \
     TARGET static void prepare_batches##SUFFIX(const wide_set *ws, contact_constraint *cc,               \
-                                               const impulse_body *bodies, double warm, int first, int last) \
+                                               const impulse_body *bodies, double warm, int friction,    \
+                                               int first, int last)                                      \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
             const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
-            ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm, lk);            \
+            if (wb->kind & WIDE_KIND_SPINLESS)                                                           \
+                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm, lk, friction); \
+            else                                                                                         \
+                ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm, lk, friction); \
         }                                                                                                \
     }                                                                                                    \
-    /* the locked batches' copies out of line: the free batches' loops stay as without them */         \
+    /* the other kinds' copies out of line: the free batches' loops stay as without them */             \
     TARGET __attribute__((noinline)) static void warm_locked##SUFFIX(const wide_set *ws, impulse_body *bodies, \
-                                                                    int first, int last)                 \
+                                                                    int friction, int first, int last)   \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            warm_batch(wb, &ws->points[wb->first], bodies, &ws->locks[wb->lock], 1);                     \
+            if (friction) warm_batch(wb, &ws->points[wb->first], bodies, &ws->locks[wb->lock], 1, 1);\
+            else warm_batch(wb, &ws->points[wb->first], bodies, &ws->locks[wb->lock], 1, 0);         \
         }                                                                                                \
     }                                                                                                    \
-    TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies, int first, int last) \
+    TARGET static void warm_batches##SUFFIX(const wide_set *ws, impulse_body *bodies, int friction, int first, \
+                                            int last)                                                    \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            warm_batch(wb, &ws->points[wb->first], bodies, NULL, 0);                                     \
+            if (friction) warm_batch(wb, &ws->points[wb->first], bodies, NULL, 0, 1);                \
+            else warm_batch(wb, &ws->points[wb->first], bodies, NULL, 0, 0);                         \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void warm_spinless##SUFFIX(const wide_set *ws, impulse_body *bodies, \
+                                                                      int friction, int first, int last) \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            if (friction) warm_batch_l(wb, &ws->lpoints[wb->first], bodies, NULL, 0, 1);             \
+            else warm_batch_l(wb, &ws->lpoints[wb->first], bodies, NULL, 0, 0);                      \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void warm_spinless_locked##SUFFIX(const wide_set *ws,        \
+                                                                             impulse_body *bodies,       \
+                                                                             int friction, int first,    \
+                                                                             int last)                   \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            if (friction) warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 1);\
+            else warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 0);      \
         }                                                                                                \
     }                                                                                                    \
     TARGET __attribute__((noinline)) static void solve_locked##SUFFIX(const wide_set *ws, const step_context *ctx, \
@@ -1116,28 +1441,56 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
             solve_batch(wb, &ws->points[wb->first], ctx, use_bias, hold_bounces, NULL, 0);               \
         }                                                                                                \
     }                                                                                                    \
+    TARGET __attribute__((noinline)) static void solve_spinless##SUFFIX(const wide_set *ws,              \
+                                                                       const step_context *ctx, int use_bias, \
+                                                                       int hold_bounces, int first, int last) \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch_l(wb, &ws->lpoints[wb->first], ctx, use_bias, hold_bounces, NULL, 0);            \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void solve_spinless_locked##SUFFIX(const wide_set *ws,       \
+                                                                              const step_context *ctx,   \
+                                                                              int use_bias,              \
+                                                                              int hold_bounces, int first, \
+                                                                              int last)                  \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch_l(wb, &ws->lpoints[wb->first], ctx, use_bias, hold_bounces, &ws->locks[wb->lock], 1); \
+        }                                                                                                \
+    }                                                                                                    \
     TARGET static void prepare_batches_c##SUFFIX(const wide_set *ws, contact_constraint *cc,             \
-                                                 const impulse_body *bodies, double warm, int first, int last) \
+                                                 const impulse_body *bodies, double warm, int friction,  \
+                                                 int first, int last)                                    \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
             const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
-            ws->deepest[k] = prepare_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], cc, bodies, warm, lk); \
+            if (wb->kind & WIDE_KIND_SPINLESS)                                                           \
+                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm, lk, friction); \
+            else                                                                                         \
+                ws->deepest[k] = prepare_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], cc, bodies, warm, \
+                                                 lk, friction);                                          \
         }                                                                                                \
     }                                                                                                    \
     TARGET __attribute__((noinline)) static void warm_locked_c##SUFFIX(const wide_set *ws, impulse_body *bodies, \
-                                                                      int first, int last)               \
+                                                                      int friction, int first, int last) \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, &ws->locks[wb->lock], 1); \
+            if (friction) warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 1);\
+            else warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 0);\
         }                                                                                                \
     }                                                                                                    \
-    TARGET static void warm_batches_c##SUFFIX(const wide_set *ws, impulse_body *bodies, int first, int last) \
+    TARGET static void warm_batches_c##SUFFIX(const wide_set *ws, impulse_body *bodies, int friction, int first, \
+                                              int last)                                                  \
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0);                 \
+            if (friction) warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0, 1);\
+            else warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0, 0);     \
         }                                                                                                \
     }                                                                                                    \
     TARGET __attribute__((noinline)) static void solve_locked_c##SUFFIX(const wide_set *ws, const step_context *ctx, \
@@ -1158,10 +1511,14 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
             solve_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], ctx, use_bias, hold_bounces, NULL, 0); \
         }                                                                                                \
     }                                                                                                    \
+    /* indexed by kind: free, locked, spinless, spinless and locked (both layouts share the spinless rows) */ \
     static const wide_kernels passes##SUFFIX = {                                                         \
-        {prepare_batches##SUFFIX, warm_batches##SUFFIX, solve_batches##SUFFIX, warm_locked##SUFFIX, solve_locked##SUFFIX}, \
-        {prepare_batches_c##SUFFIX, warm_batches_c##SUFFIX, solve_batches_c##SUFFIX, warm_locked_c##SUFFIX, \
-         solve_locked_c##SUFFIX}};
+        {prepare_batches##SUFFIX,                                                                        \
+         {warm_batches##SUFFIX, warm_locked##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX}, \
+         {solve_batches##SUFFIX, solve_locked##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX}}, \
+        {prepare_batches_c##SUFFIX,                                                                      \
+         {warm_batches_c##SUFFIX, warm_locked_c##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX}, \
+         {solve_batches_c##SUFFIX, solve_locked_c##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX}}};
 
 WIDE_PASSES(_base, )
 #if WIDE_AVX2
@@ -1191,34 +1548,45 @@ typedef struct wide_job {
     const step_context *ctx;
     contact_constraint *cc;
     int offset, use_bias, hold_bounces;
-    int split;                   /* the colour's first locked batch */
+    int color;                   /* the colour in hand (warm start and solve) */
 } wide_job;
 
 static void prepare_range(int begin, int end, int worker, void *p)
 {
     const wide_job *j = p;
     (void)worker;
-    j->passes->prepare(j->ws, j->cc, j->ctx->bodies, j->ctx->warm_starting ? 1.0 : 0.0, j->offset + begin,
-                       j->offset + end);
+    j->passes->prepare(j->ws, j->cc, j->ctx->bodies, j->ctx->warm_starting ? 1.0 : 0.0, j->ctx->friction,
+                       j->offset + begin, j->offset + end);
+}
+
+/* The part of [first, last) that holds kind k's batches of the colour in hand. */
+static int kind_span(const wide_job *j, int k, int first, int last, int *from, int *to)
+{
+    const wide_set *ws = j->ws;
+    int lo = ws->kind_first[j->color][k];
+    int hi = k + 1 < WIDE_KINDS ? ws->kind_first[j->color][k + 1] : ws->color_first[j->color + 1];
+    *from = lo > first ? lo : first;
+    *to = hi < last ? hi : last;
+    return *from < *to;
 }
 
 static void warm_range(int begin, int end, int worker, void *p)
 {
     const wide_job *j = p;
     (void)worker;
-    /* a colour's locked batches (split on) come after its free ones */
-    int first = j->offset + begin, last = j->offset + end, mid = j->split < last ? j->split : last;
-    if (first < mid) j->passes->warm(j->ws, j->ctx->bodies, first, mid);
-    if (mid < last) j->passes->warm_locked(j->ws, j->ctx->bodies, mid > first ? mid : first, last);
+    int first = j->offset + begin, last = j->offset + end, from, to;
+    for (int k = 0; k < WIDE_KINDS; k++)
+        if (kind_span(j, k, first, last, &from, &to)) j->passes->warm[k](j->ws, j->ctx->bodies, j->ctx->friction, from, to);
 }
 
 static void solve_range(int begin, int end, int worker, void *p)
 {
     const wide_job *j = p;
     (void)worker;
-    int first = j->offset + begin, last = j->offset + end, mid = j->split < last ? j->split : last;
-    if (first < mid) j->passes->solve(j->ws, j->ctx, j->use_bias, j->hold_bounces, first, mid);
-    if (mid < last) j->passes->solve_locked(j->ws, j->ctx, j->use_bias, j->hold_bounces, mid > first ? mid : first, last);
+    int first = j->offset + begin, last = j->offset + end, from, to;
+    for (int k = 0; k < WIDE_KINDS; k++)
+        if (kind_span(j, k, first, last, &from, &to))
+            j->passes->solve[k](j->ws, j->ctx, j->use_bias, j->hold_bounces, from, to);
 }
 
 /* Prepare reads the bodies and writes only its own batches: every batch at
@@ -1240,7 +1608,7 @@ void wide_warm_start(const wide_set *ws, const step_context *ctx)
     wide_job j = {ws, passes_for(ws), ctx, NULL, 0, 0, 0, 0};
     for (int c = 0; c < WIDE_COLORS; c++) {
         j.offset = ws->color_first[c];
-        j.split = ws->color_locked[c];
+        j.color = c;
         tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, warm_range, &j);
     }
 }
@@ -1250,7 +1618,7 @@ void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int h
     wide_job j = {ws, passes_for(ws), ctx, NULL, 0, use_bias, hold_bounces, 0};
     for (int c = 0; c < WIDE_COLORS; c++) {
         j.offset = ws->color_first[c];
-        j.split = ws->color_locked[c];
+        j.color = c;
         tasks_run(ctx->tasks, ws->color_first[c + 1] - j.offset, WIDE_MIN_RANGE, solve_range, &j);
     }
 }
@@ -1274,51 +1642,58 @@ int wide_overflow(const wide_set *ws, const int **list)
     return ws->overflow_count;
 }
 
+/* A batched constraint's impulses from whichever layout its batch has. */
+#define READ_IMPULSES(PTS)                                                \
+    for (int i = 0; i < c->count; i++) {                                  \
+        const PTS *q = &(PTS##_array)[wb->first + i];                     \
+        c->p[i].normal_impulse = q->normal_impulse[l];                    \
+        c->p[i].tangent_impulse[0] = q->tangent_impulse[0][l];            \
+        c->p[i].tangent_impulse[1] = q->tangent_impulse[1][l];            \
+    }
+
 void wide_read_impulses(const wide_set *ws, contact_constraint *c)
 {
     const wide_batch *wb = &ws->batches[c->wide_batch];
     int l = c->wide_lane;
-    if (ws->compact) {
-        for (int i = 0; i < c->count; i++) {
-            const wide_cpoint *q = &ws->cpoints[wb->first + i];
-            c->p[i].normal_impulse = q->normal_impulse[l];
-            c->p[i].tangent_impulse[0] = q->tangent_impulse[0][l];
-            c->p[i].tangent_impulse[1] = q->tangent_impulse[1][l];
-        }
-        return;
-    }
-    for (int i = 0; i < c->count; i++) {
-        const wide_point *q = &ws->points[wb->first + i];
-        c->p[i].normal_impulse = q->normal_impulse[l];
-        c->p[i].tangent_impulse[0] = q->tangent_impulse[0][l];
-        c->p[i].tangent_impulse[1] = q->tangent_impulse[1][l];
+    if (wb->kind & WIDE_KIND_SPINLESS) {
+        const wide_lpoint *wide_lpoint_array = ws->lpoints;
+        READ_IMPULSES(wide_lpoint)
+    } else if (ws->compact) {
+        const wide_cpoint *wide_cpoint_array = ws->cpoints;
+        READ_IMPULSES(wide_cpoint)
+    } else {
+        const wide_point *wide_point_array = ws->points;
+        READ_IMPULSES(wide_point)
     }
 }
 
-/* The loop over either layout's points (one branch a call, not a lane). */
+/* One batch's points of either layout back to its constraints' points. */
 #define STORE_POINTS(PTS)                                                                          \
-    for (int k = 0; k < ws->batch_count; k++) {                                                    \
-        const wide_batch *wb = &ws->batches[k];                                                    \
-        for (int l = 0; l < wb->lanes; l++) {                                                      \
-            contact_constraint *c = &cc[wb->con[l]];                                               \
-            for (int i = 0; i < wb->count; i++) {                                                  \
-                const PTS *q = &PTS##_array[wb->first + i];                                       \
-                constraint_point *p = &c->p[i];                                                    \
-                p->normal_impulse = q->normal_impulse[l];                                          \
-                p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */ \
-                p->tangent_impulse[0] = q->tangent_impulse[0][l];                                  \
-                p->tangent_impulse[1] = q->tangent_impulse[1][l];                                  \
-            }                                                                                      \
+    for (int l = 0; l < wb->lanes; l++) {                                                          \
+        contact_constraint *c = &cc[wb->con[l]];                                                   \
+        for (int i = 0; i < wb->count; i++) {                                                      \
+            const PTS *q = &(PTS##_array)[wb->first + i];                                          \
+            constraint_point *p = &c->p[i];                                                        \
+            p->normal_impulse = q->normal_impulse[l];                                              \
+            p->total_normal_impulse += q->total_normal_impulse[l]; /* plus any shock pass's */     \
+            p->tangent_impulse[0] = q->tangent_impulse[0][l];                                      \
+            p->tangent_impulse[1] = q->tangent_impulse[1][l];                                      \
         }                                                                                          \
     }
 
 void wide_store(const wide_set *ws, contact_constraint *cc)
 {
-    if (ws->compact) {
-        const wide_cpoint *wide_cpoint_array = ws->cpoints;
-        STORE_POINTS(wide_cpoint)
-    } else {
-        const wide_point *wide_point_array = ws->points;
-        STORE_POINTS(wide_point)
+    const wide_point *wide_point_array = ws->points;
+    const wide_cpoint *wide_cpoint_array = ws->cpoints;
+    const wide_lpoint *wide_lpoint_array = ws->lpoints;
+    for (int k = 0; k < ws->batch_count; k++) {
+        const wide_batch *wb = &ws->batches[k];
+        if (wb->kind & WIDE_KIND_SPINLESS) {
+            STORE_POINTS(wide_lpoint)
+        } else if (ws->compact) {
+            STORE_POINTS(wide_cpoint)
+        } else {
+            STORE_POINTS(wide_point)
+        }
     }
 }

@@ -15,10 +15,11 @@ enum { WIDE_ENV_READ = 1, WIDE_ENV_NO_AVX2 = 2, WIDE_ENV_FULL = 4, WIDE_ENV_COMP
 int wide_read_env(void);
 /* Colours the constraints and lays out the batches in *mem (grown as
  * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
- * and filling the batch headers; nlocked: how many constraints have a
- * plane-locked body (they get batches of their own); env: wide_read_env's.
+ * and filling the batch headers; manifolds with a plane-locked body
+ * (locked) or with no body that can turn (spinless) get batches of their
+ * own (kinds 0: the caller knows there are none); env: wide_read_env's.
  * NULL on out of memory. */
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int nlocked, int nb, int env);
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env);
 /* The constraints left to the scalar passes, in order. */
 int wide_overflow(const wide_set *ws, const int **list);
 /* Prepares every batched manifold's points four lanes at a time, as

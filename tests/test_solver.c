@@ -580,7 +580,7 @@ static void test_momentum_conserved_in_free_collisions(void **state)
  * (contact_solver.c), the wide ones point after point, so the sliding
  * boxes (4 points) are held to the analytic answer only: the two differ
  * by 1.9e-5 m of the 2.55 m slide; the 1-point manifolds to rounding. */
-enum { ROW_SLIDE, ROW_ROLL, ROW_BOUNCE, ROW_SLIDE_LOCKED, ROW_TILT_LOCKED };
+enum { ROW_SLIDE, ROW_ROLL, ROW_BOUNCE, ROW_SLIDE_LOCKED, ROW_TILT_LOCKED, ROW_SLIDE_SPINLESS, ROW_TILT_SPINLESS };
 
 static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
 {
@@ -598,6 +598,16 @@ static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
             d.shape = carom_shape_box(0.5, 0.5, 0.5);
             d.friction = 0.5;
             d.lock_to_plane = kind == ROW_SLIDE_LOCKED; /* the x-z plane */
+        } else if (kind == ROW_SLIDE_SPINLESS || kind == ROW_TILT_SPINLESS) {
+            /* a rotation-locked sphere (it cannot roll: it slides), and the
+             * same also locked to the tilted plane below */
+            d.position = vec(x, y, 0.25);
+            d.shape = carom_shape_sphere(0.25);
+            d.friction = 0.5;
+            d.lock_rotation = 1;
+            d.lock_to_plane = kind == ROW_TILT_SPINLESS;
+            d.plane_normal = vec(0, 0.6, 0.8);
+            d.linear_velocity = vec(5, 0, 0);
         } else if (kind == ROW_TILT_LOCKED) {
             /* a sphere locked to a plane tilted 37 degrees about x: the
              * ground's normal has a part along the lock, and the sphere may
@@ -622,7 +632,7 @@ static void run_row(int kind, int n, carom_vec3 *end_pos, carom_vec3 *end_vel)
         step_n(w, 10, DT);
         for (int i = 0; i < n; i++) assert_int_equal(carom_body_set_linear_velocity(w, ids[i], vec(5, 0, 0)), CAROM_OK);
     }
-    int steps = kind == ROW_ROLL || kind == ROW_TILT_LOCKED ? 120 : kind == ROW_BOUNCE ? 40 : 180;
+    int steps = kind == ROW_ROLL || kind == ROW_TILT_LOCKED || kind == ROW_TILT_SPINLESS ? 120 : kind == ROW_BOUNCE ? 40 : 180;
     int most = 0;
     for (int s = 0; s < steps; s++) {
         step_n(w, 1, DT);
@@ -705,6 +715,44 @@ static void test_wide_locked_match_scalar(void **state)
                 EXPECT_NEAR(row_p[i].x, 25.0 / (2 * 0.5 * G), 0.03 * 25.0 / (2 * 0.5 * G), "locked stopping distance");
         }
         if (kind == ROW_TILT_LOCKED) assert_true(ref_p[0].x > 0.5); /* it moved along the plane */
+    }
+}
+
+/* Manifolds whose bodies cannot turn (rotation-locked, on the static
+ * ground) take the wide passes' linear rows (solver_wide.c, wide_lpoint):
+ * a row of rotation-locked spheres slid at 5 m/s along x stops at the
+ * analytic v^2 / (2 mu g) and follows the lone sphere, solved by the scalar
+ * passes (1-point manifolds: the same rows), to rounding, never turning; the
+ * same spheres also locked to a plane tilted about x (the linear rows with
+ * the lock kept per lane) stay in their plane and follow their lone one. */
+static void test_wide_spinless_match_scalar(void **state)
+{
+    (void)state;
+    const int n = 96;
+    carom_vec3 lone_p, lone_v, row_p[96], row_v[96];
+    for (int kind = ROW_SLIDE_SPINLESS; kind <= ROW_TILT_SPINLESS; kind++) {
+        run_row(kind, 1, &lone_p, &lone_v);
+        run_row(kind, n, row_p, row_v);
+        carom_vec3 nrm = vec(0, 0.6, 0.8);
+        for (int i = 0; i < n; i++) {
+            double dp = fabs(row_p[i].x - lone_p.x) + fabs(row_p[i].y - lone_p.y) + fabs(row_p[i].z - lone_p.z);
+            double dv = fabs(row_v[i].x - lone_v.x) + fabs(row_v[i].y - lone_v.y) + fabs(row_v[i].z - lone_v.z);
+            if (!(dp < 1e-9 && dv < 1e-9)) {
+                print_error("kind %d body %d: spinless wide differs from scalar by %.3g m, %.3g m/s\n", kind, i, dp, dv);
+                fail();
+            }
+            if (kind == ROW_TILT_SPINLESS) {
+                double vn = row_v[i].x * nrm.x + row_v[i].y * nrm.y + row_v[i].z * nrm.z;
+                assert_true(fabs(vn) <= 1e-12);
+            }
+        }
+        if (kind == ROW_SLIDE_SPINLESS) {
+            /* 180 steps: long stopped (5 / (0.5 g) = 1.02 s) */
+            EXPECT_NEAR(lone_p.x, 25.0 / (2 * 0.5 * G), 0.03 * 25.0 / (2 * 0.5 * G), "spinless stopping distance");
+            assert_true(fabs(lone_v.x) < 1e-6);
+        } else {
+            assert_true(lone_p.x > 0.5); /* it moved along the plane */
+        }
     }
 }
 
@@ -1463,6 +1511,7 @@ int main(void)
         cmocka_unit_test(test_wide_passes_match_scalar),
         cmocka_unit_test(test_wide_kernels_agree),
         cmocka_unit_test(test_wide_locked_match_scalar),
+        cmocka_unit_test(test_wide_spinless_match_scalar),
         cmocka_unit_test(test_mass_ratio_holds_in_a_wide_step),
         cmocka_unit_test(test_compact_rows_match),
         cmocka_unit_test(test_resting_sag_is_the_soft_deflection),
