@@ -70,7 +70,20 @@ static inline void fuzz_fix_snapshot_header(unsigned char *p, size_t n)
     for (int k = 0; k < 8; k++) p[16 + k] = (unsigned char)((uint64_t)n >> (8 * k));
     const unsigned char *q = p + 32;
     size_t m = n - 32, i = 0;
-    uint64_t h = 0x9e3779b97f4a7c15ULL ^ (uint64_t)m;
+    uint64_t lane[4], h;
+    for (int k = 0; k < 4; k++) lane[k] = 0x9e3779b97f4a7c15ULL ^ (uint64_t)m ^ ((uint64_t)k << 56);
+    for (; i + 32 <= m; i += 32)
+        for (int k = 0; k < 4; k++) {
+            uint64_t v = 0;
+            for (int b = 7; b >= 0; b--) v = (v << 8) | q[i + 8 * (size_t)k + (size_t)b];
+            lane[k] = (lane[k] ^ v) * 0xff51afd7ed558ccdULL;
+            lane[k] ^= lane[k] >> 29;
+        }
+    h = lane[0];
+    for (int k = 1; k < 4; k++) {
+        h = (h ^ lane[k]) * 0xff51afd7ed558ccdULL;
+        h ^= h >> 29;
+    }
     for (; i + 8 <= m; i += 8) {
         uint64_t v = 0;
         for (int k = 7; k >= 0; k--) v = (v << 8) | q[i + (size_t)k];
