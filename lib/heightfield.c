@@ -36,6 +36,18 @@ int heightfield_check(const double *heights, int rows, int columns, double cell_
     if (hole_count < 0 || (hole_count > 0 && !holes)) HF_CHECK_FAIL("heightfield holes: bad list (count %d)", hole_count);
     for (int i = 0; i < hole_count; i++)
         if (holes[i] < 0 || holes[i] >= cells) HF_CHECK_FAIL("heightfield holes[%d]: cell %d out of range 0..%d", i, holes[i], cells - 1);
+    /* a field whose every cell is a hole has no ground at all, as a mesh of
+     * zero-area triangles only has none: refused the same way (the list may
+     * repeat cells, so they are counted once each) */
+    if (hole_count >= cells) {
+        unsigned char *seen = calloc((size_t)cells, 1);
+        int distinct = 0;
+        if (seen) {
+            for (int i = 0; i < hole_count; i++) distinct += !seen[holes[i]], seen[holes[i]] = 1;
+            free(seen);
+        }
+        if (distinct == cells) HF_CHECK_FAIL("heightfield holes: all %d cells are holes (no ground left)", cells);
+    }
     return 1;
 #undef HF_CHECK_FAIL
 }

@@ -241,8 +241,10 @@ void mesh_free(tri_mesh *m)
 int mesh_check(const double *vertices, int vertex_count, const int *triangles, int triangle_count, char *err,
                int err_size)
 {
-    if (!vertices || vertex_count < 3) { fail(err, err_size, "mesh vertices: need at least 3 (got %d)", vertex_count, 0); return 0; }
-    if (!triangles || triangle_count < 1) { fail(err, err_size, "mesh triangles: need at least 1 (got %d)", triangle_count, 0); return 0; }
+    if (vertex_count < 3) { fail(err, err_size, "mesh vertices: need at least 3 (got %d)", vertex_count, 0); return 0; }
+    if (!vertices) { fail(err, err_size, "mesh vertices: NULL (vertex_count %d)", vertex_count, 0); return 0; }
+    if (triangle_count < 1) { fail(err, err_size, "mesh triangles: need at least 1 (got %d)", triangle_count, 0); return 0; }
+    if (!triangles) { fail(err, err_size, "mesh triangles: NULL (triangle_count %d)", triangle_count, 0); return 0; }
     if (vertex_count > 100000000 || triangle_count > 100000000) { fail(err, err_size, "mesh: too large (%d vertices, %d triangles)", vertex_count, triangle_count); return 0; }
     for (int i = 0; i < 3 * vertex_count; i++)
         if (!isfinite(vertices[i]) || fabs(vertices[i]) > RANGE_LENGTH_MAX) {

@@ -839,6 +839,10 @@ static void test_bad_input_refused(void **state)
     /* empty, missing */
     flat.triangle_count = 0;
     expect_refused(w, &bd, "triangles");
+    flat.triangle_count = 1;
+    flat.vertices = NULL; expect_refused(w, &bd, "mesh vertices: NULL");
+    flat.vertices = line;
+    flat.triangles = NULL; expect_refused(w, &bd, "mesh triangles: NULL");
     bd.mesh = NULL;
     expect_refused(w, &bd, "NULL");
     /* height fields: NaN height, bad sizes, bad holes, dynamic */
@@ -856,10 +860,16 @@ static void test_bad_input_refused(void **state)
     int holes[1] = {4};
     hd.holes = holes; hd.hole_count = 1; expect_refused(w, &bd, "holes[0]");
     holes[0] = 3;
+    /* every cell a hole (one listed twice): no ground at all, as a mesh of zero-area triangles */
+    int all[5] = {3, 0, 2, 0, 1};
+    hd.holes = all; hd.hole_count = 5; expect_refused(w, &bd, "all 4 cells are holes");
+    all[4] = 2; /* cell 1 left: accepted */
+    assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
+    hd.holes = holes; hd.hole_count = 1;
     bd.type = CAROM_BODY_DYNAMIC; expect_refused(w, &bd, "static or kinematic");
     bd.type = CAROM_BODY_STATIC;
     assert_false(carom_body_id_is_null(carom_body_create(w, &bd)));
-    assert_int_equal(carom_world_body_count(w), 2);
+    assert_int_equal(carom_world_body_count(w), 3);
     /* degenerate triangles among good ones are dropped, not fatal; an open mesh is fine */
     double dv[12] = {0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0};
     int dt[6] = {0, 1, 2, 0, 1, 3};

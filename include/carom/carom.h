@@ -289,7 +289,7 @@ typedef struct carom_heightfield_def {
     const double *heights;    /* rows * columns, row 0 at the lowest y */
     int rows, columns;        /* >= 2 each */
     double cell_x, cell_y;    /* grid spacing (m), > 0 */
-    const int *holes;         /* NULL or hole_count cell indices without ground */
+    const int *holes;         /* NULL or hole_count cell indices without ground (not all of them) */
     int hole_count;
 } carom_heightfield_def;
 
