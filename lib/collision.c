@@ -131,18 +131,44 @@ static xform relative_pose(const xform *xa, const xform *xb)
     return r;
 }
 
+/* A round shape's radius of curvature (its radius); 0 for shapes whose
+ * contacts lie on faces, edges and corners. */
+static double round_radius(const shape *s)
+{
+    const unsigned round = 1u << SHAPE_SPHERE | 1u << SHAPE_CAPSULE | 1u << SHAPE_CYLINDER;
+    return (unsigned)s->type < 32 && (round >> s->type & 1u) ? s->radius : 0.0;
+}
+
 /* Keeps last manifold when B's material at every contact point has moved less
  * than `reuse` relative to A since the manifold was computed (a resting pair
  * moves micrometres a step): each separation changes by the normal component
  * of that motion, exact to first order, the point by half of it. now: B's
- * frame in A's (relative_pose). Returns 1 when the manifold was kept. */
-static int reuse_manifold(const contact *c, contact_data *d, const xform *xa, const xform *now, double reuse)
+ * frame in A's (relative_pose); sa, sb: the two shapes. Returns 1 when the
+ * manifold was kept. */
+static int reuse_manifold(const contact *c, contact_data *d, const xform *xa, const xform *now, double reuse,
+                          const shape *sa, const shape *sb)
 {
     if (!(c->flags & CONTACT_REUSABLE) || d->m.count == 0 || !(reuse > 0)) return 0;
     if (v3_len2(v3_sub(now->p, c->rel_pose.p)) > reuse * reuse) return 0;
     /* B's motion in A's frame since then, x -> R x + t, as a matrix: one
      * product per point instead of two quaternion rotations */
     quat dq = q_mul(now->q, q_conj(c->rel_pose.q));
+    /* A round shape rolling on the other has no motion at its contact point
+     * (rolling: the two materials there move together), yet its contact moves
+     * along its surface by the radius times the turn: a sphere created
+     * before the plane it rolls on (the sphere A), whose path crossed the
+     * line through the plane's origin along its axis, kept its manifold
+     * while the old contact point rose and went behind, and sank 6 mm and sped up
+     * 9 % at fast. So the chord of the turn about axes across the normal at the
+     * round shape's radius (its radius of curvature), 2 r sin(angle / 2),
+     * must stay within `reuse` too; a turn about the normal moves no round
+     * contact along its surface (and the points off its axis are tested below). */
+    double round = dmax(round_radius(sa), round_radius(sb));
+    if (round > 0) {
+        vec3 axis = v3(dq.x, dq.y, dq.z); /* sin(angle / 2) times the turn's axis, in A's frame */
+        vec3 rolling = v3_sub(axis, v3_scale(d->normal_a, v3_dot(axis, d->normal_a)));
+        if (4.0 * round * round * v3_len2(rolling) > reuse * reuse) return 0;
+    }
     mat3 R = m3_from_quat(dq);
     vec3 t = v3_sub(now->p, q_rotate(dq, c->rel_pose.p));
     vec3 moved[MANIFOLD_MAX_POINTS];
@@ -357,7 +383,8 @@ COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i
     const xform *xa = awake_a ? &sc->pose[a] : (xa_own = body_xform(s, a), &xa_own);
     const xform *xb = awake_b ? &sc->pose[b] : (xb_own = body_xform(s, b), &xb_own);
     xform now = relative_pose(xa, xb);
-    if (reuse_manifold(c, d, xa, &now, reuse)) return 1; /* kept: ids, impulses and feature cache stay as they were */
+    if (reuse_manifold(c, d, xa, &now, reuse, &s->shapes[a], &s->shapes[b]))
+        return 1; /* kept: ids, impulses and feature cache stay as they were */
     if (still_apart(c, &now, spec)) return 0;
     const manifold *m = &d->m;
     manifold found;
