@@ -93,6 +93,18 @@ static double turn_reach(const shape *s, vec3 com, vec3 u)
         for (int k = 0; k < s->hull->vertex_count; k++)
             m = dmax(m, v3_len(v3_cross(v3_sub(s->hull->vertices[k], com), u)));
         return m;
+    case SHAPE_COMPOUND:
+        /* each child about the same axis, in its own frame: a dumbbell rolling
+         * on its spheres turns about the line through their centres and moves
+         * no surface by it (its bounding reach, 0.55 m at 28 rad/s, made each
+         * step's advancement creep 9 mm at a time until the iterations ran
+         * out: at dt 1/30 it stopped it 45 % into the step, 20 % short after
+         * 2 s down a slope) */
+        for (int i = 0; i < s->compound->count; i++) {
+            xform p = s->compound->poses[i];
+            m = dmax(m, turn_reach(&s->compound->children[i], q_inv_rotate(p.q, v3_sub(com, p.p)), q_inv_rotate(p.q, u)));
+        }
+        return m;
     default: return shape_bounding_radius(s) + v3_len(com);
     }
 }
