@@ -226,27 +226,46 @@ static int block_lcp(int n, double A[4][4], const double b[4], double x[4], int 
  * to twice the setting's frequency (four times as stiff), where
  * loaded_softness (solver.c) stops at sqrt 2 for the manifolds swept point
  * after point: the same f' = f min(sqrt(1 + m_load / m), cap), never past
- * max(f, 1/(4h)), with the cap 2 here. Swept, the stiffer spring rocked a
- * column sideways (cap 2: the pyramid, wide, max_disp 1.5 -> 5.1 cm at
- * default); solved as a block it does not, and the 10-column at default
- * settles 0.69 cm (1.31), the 20-tower 2.8 cm (5.4), the 40-tower 11 cm
- * (22; accurate 2.8 cm, 5.5). Only with relax passes, as loaded_softness:
- * at fast the stiffer spring set the 40-tower bouncing (up 8.8 cm, fallen
- * by 15 s). Past 1/(4h) every tower walks (1/(2h): the 20-tower 0.78 m).
- * Returns 0 when the setting's softness stays (the caller keeps c->soft). */
-#define BLOCK_STIFFENING_MAX 2.0
+ * max(f, 1/(4h)), with the cap 2 here; with two iterations or more
+ * (accurate) the cap is 4 and the limit max(f, 1/(2h)). A manifold past
+ * 1/(4h) is marked
+ * stiff: the pass that solves it is followed by BLOCK_STIFF_SWEEPS sweeps
+ * of the stiff manifolds' normal rows alone (solver.c). Without them one
+ * Gauss-Seidel pass does not hold such a spring: past 1/(4h) every tower
+ * walked sideways (a stack's tilt modes, each point its own spring, swing at
+ * 1.22 f and grew from rounding: 1.25/(4h) held, 1.5/(4h) walked the
+ * 20-tower 25 cm at default, 1/(2h) 0.55 m), at any damping ratio (1-40)
+ * and with any share of last step's load taken off the spring's rest length
+ * (the 40-tower fell). One more whole pass held 1.5/(4h) (the cost of a
+ * second iteration); the normal rows of the stiff manifolds alone, three
+ * times, hold 1/(2h) (two: the 40-tower leaned 1e-6 m and growing; 3/(4h)
+ * did not hold even with five: leaned 2 cm to 1.7 m). Measured (top box, 10 s, dt 1/60, sag; default if
+ * it were allowed there / accurate): the 20-tower 2.77 -> 0.76 cm / 0.69 ->
+ * 0.19 cm, the 40-tower 11.05 -> 2.83 cm / 2.76 -> 0.71 cm. Only with relax passes, as
+ * loaded_softness: at fast the stiffer spring set the 40-tower bouncing (up
+ * 8.8 cm, fallen by 15 s). Returns 0 when the setting's softness stays (the
+ * caller keeps c->soft). */
+#define BLOCK_STIFFENING_MAX 4.0
 static int block_loaded_softness(const contact_constraint *c, const step_context *ctx, double mA, double mB,
-                                 softness *out)
+                                 softness *out, int *stiff)
 {
+    *stiff = 0;
     if (!(ctx->relax_iterations > 0 && ctx->warm_starting && ctx->gravity_length > 0.0 && mA + mB > 0.0)) return 0;
     if (c->soft.mass_scale == 1.0 && c->soft.impulse_scale == 0.0) return 0; /* held rigidly (touching impact) */
     double load = 0.0;
     for (int j = 0; j < c->count; j++) load += c->warm[j].normal_impulse;
     double ratio = load * (mA + mB) / (ctx->h * ctx->gravity_length);
-    double f = dmin(sqrt(1.0 + ratio), BLOCK_STIFFENING_MAX);
+    /* past 1/(4h) only with two iterations or more: at one the sweeps would
+     * run nearly everywhere (the 10-box stack at default: 137.6M -> 258.5M
+     * instructions, callgrind, for a column it already holds to 0.69 cm) */
+    int past = ctx->iterations >= 2;
+    double f = dmin(sqrt(1.0 + ratio), past ? BLOCK_STIFFENING_MAX : 2.0);
     if (!(f > 1.4142135623730951)) return 0; /* loaded_softness's own answer */
     double hertz = (mA == 0.0 || mB == 0.0 ? 2.0 : 1.0) * ctx->contact_hertz;
-    *out = make_softness(dmin(hertz * f, dmax(hertz, 0.25 * ctx->inv_h)), ctx->contact_damping_ratio, ctx->h);
+    double quarter = 0.25 * ctx->inv_h;
+    double stiffened = dmin(hertz * f, dmax(hertz, past ? 2.0 * quarter : quarter));
+    *stiff = stiffened > dmax(hertz, quarter);
+    *out = make_softness(stiffened, ctx->contact_damping_ratio, ctx->h);
     return 1;
 }
 
@@ -266,9 +285,11 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
     blk->ready = 0;
     blk->factored[0] = blk->factored[1] = 0;
     blk->shock_ready = 0;
+    blk->stiff = 0;
     if (count < 2 || c->locked) return;
     softness setting = c->soft; /* kept for a manifold that ends up swept */
-    block_loaded_softness(c, ctx, mA, mB, &c->soft);
+    int stiff;
+    block_loaded_softness(c, ctx, mA, mB, &c->soft, &stiff);
     for (int i = 0; i < count; i++) {
         const constraint_rows *p = &c->r[i];
         if (!(p->normal_mass > 0.0)) {
@@ -281,6 +302,7 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
         }
     }
     blk->ready = 1;
+    blk->stiff = stiff;
 }
 
 /* The factor of K + (gamma + BLOCK_EPS) diag(K) (soft 1: every row soft) or
@@ -536,6 +558,13 @@ SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx,
     if (c->rolling > 0.0) solve_rolling(c, &wA, &wB, A, B);
     A->v = vA; A->w = wA;
     B->v = vB; B->w = wB;
+}
+
+void contact_solve_normals(contact_constraint *c, const step_context *ctx, int use_bias)
+{
+    impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
+    solve_normals_block(c, &ctx->blocks[c - ctx->constraints], ctx, use_bias, &A->v, &A->w, &B->v, &B->w, A->inv_mass,
+                        B->inv_mass);
 }
 
 void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces)

@@ -16,6 +16,7 @@ typedef struct contact_block {
     int ready;                   /* 0: sweep the rows one by one */
     int factored[2];             /* inv[k]: 1 made, -1 failed, 0 not yet */
     int shock_ready;
+    int stiff;                   /* springs past a quarter of the sub-step rate: swept again (contact_solve_normals) */
 } contact_block;
 
 /* Anchors, rows, effective masses, warm impulses and the approach velocity
@@ -29,6 +30,9 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies);
  * manifolds with restitution add no impulse; they would stop an approach
  * that meets its contact next step, where the impact phase meets it. */
 void contact_solve(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces);
+/* The normal rows alone of a block-solved manifold, solved again: the
+ * extra sweeps over the stiff manifolds (contact_block.stiff) after a pass. */
+void contact_solve_normals(contact_constraint *c, const step_context *ctx, int use_bias);
 /* Shock propagation's pass: the lower body (lower_is_a: a) held immovable. */
 void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces, int lower_is_a);
 

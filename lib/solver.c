@@ -59,6 +59,7 @@ typedef struct solver_work {
     double max_penetration;
     int points;
     int locked;                  /* constraints with a plane-locked body */
+    int stiff;                   /* scalar manifolds marked stiff (contact_block.stiff) */
 } solver_work;
 
 /* What the sub-steps read of a solver body, computed once per step from the
@@ -757,6 +758,7 @@ static void prepare_points(const step_context *ctx, solver_work *work)
 {
     work->max_penetration = 0.0;
     work->points = 0;
+    work->stiff = 0;
     if (work->wide) {
         work->max_penetration = wide_prepare(work->wide, ctx->constraints, ctx);
         work->points = ctx->point_count;
@@ -765,6 +767,7 @@ static void prepare_points(const step_context *ctx, solver_work *work)
         contact_constraint *c = scalar_constraint(ctx, work, k);
         work->max_penetration = dmax(work->max_penetration, contact_prepare(c, ctx));
         if (!work->wide) work->points += c->count;
+        if (ctx->blocks) work->stiff += ctx->blocks[c - ctx->constraints].stiff;
     }
 }
 
@@ -811,12 +814,22 @@ static void warm_start(const step_context *ctx, const solver_work *work)
     for (int k = 0; k < work->scalar_count; k++) contact_warm_start(scalar_constraint(ctx, work, k), ctx->bodies);
 }
 
+/* Sweeps of the stiff manifolds' normal rows after each pass. */
+#define BLOCK_STIFF_SWEEPS 3
+
 /* One pass over every manifold: the batches four at a time, the rest one at a time. */
 static void solve_pass(const step_context *ctx, const solver_work *work, int use_bias, int hold_bounces)
 {
     if (work->wide) wide_solve(work->wide, ctx, use_bias, hold_bounces);
     for (int k = 0; k < work->scalar_count; k++)
         contact_solve(scalar_constraint(ctx, work, k), ctx, use_bias, hold_bounces);
+    /* the stiff manifolds' normal rows again (contact_solver.c, block_loaded_softness) */
+    for (int e = 0; e < BLOCK_STIFF_SWEEPS && work->stiff > 0; e++) {
+        for (int k = 0; k < work->scalar_count; k++) {
+            contact_constraint *c = scalar_constraint(ctx, work, k);
+            if (ctx->blocks[c - ctx->constraints].stiff) contact_solve_normals(c, ctx, use_bias);
+        }
+    }
 }
 
 static void shock_pass(const step_context *ctx, const solver_work *work, int use_bias, int hold_bounces)
