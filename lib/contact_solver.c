@@ -7,8 +7,10 @@
 
 #if defined(__GNUC__)
 #define SOLVE_INLINE static inline __attribute__((always_inline))
+#define SOLVE_OUTLINE static __attribute__((noinline))
 #else
 #define SOLVE_INLINE static inline
+#define SOLVE_OUTLINE static
 #endif
 
 
@@ -307,18 +309,24 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
 
 /* The factor of K + (gamma + BLOCK_EPS) diag(K) (soft 1: every row soft) or
  * K + BLOCK_EPS diag(K) (soft 0: every row rigid), made at its first use;
- * NULL when it cannot be (the block is then solved by enumeration). */
-static double (*block_inverse(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft))[4]
+ * NULL when it cannot be (the block is then solved by enumeration). The
+ * factoring is out of line (twice a step) and the test inline (every
+ * solve), so the solve's two callers (contact_solve, contact_solve_normals)
+ * each keep it inline. */
+SOLVE_OUTLINE void block_make_factor(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft)
 {
-    if (!blk->factored[soft]) {
-        const int count = c->count;
-        double e = (soft ? block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
-        for (int i = 0; i < count; i++) {
-            for (int j = 0; j < count; j++) A[i][j] = blk->K[i][j];
-            A[i][i] += e * blk->K[i][i];
-        }
-        blk->factored[soft] = block_factor(count, A, blk->inv[soft]) ? 1 : -1;
+    const int count = c->count;
+    double e = (soft ? block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
+    for (int i = 0; i < count; i++) {
+        for (int j = 0; j < count; j++) A[i][j] = blk->K[i][j];
+        A[i][i] += e * blk->K[i][i];
     }
+    blk->factored[soft] = block_factor(count, A, blk->inv[soft]) ? 1 : -1;
+}
+
+SOLVE_INLINE double (*block_inverse(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft))[4]
+{
+    if (!blk->factored[soft]) block_make_factor(c, blk, ctx, soft);
     return blk->factored[soft] > 0 ? blk->inv[soft] : NULL;
 }
 
@@ -353,7 +361,7 @@ static int block_totals(int count, double K[4][4], double inv[4][4], const doubl
 
 /* The normal rows of an unlocked manifold of 2-4 points solved as a block;
  * 0 (nothing changed) when the caller must sweep them instead. */
-static int solve_normals_block(contact_constraint *c, contact_block *blk, const step_context *ctx, int use_bias,
+SOLVE_INLINE int solve_normals_block(contact_constraint *c, contact_block *blk, const step_context *ctx, int use_bias,
                                vec3 *vA, vec3 *wA, vec3 *vB, vec3 *wB, double mA, double mB)
 {
     const int count = c->count;
@@ -458,18 +466,30 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
 void contact_warm_start(contact_constraint *c, impulse_body *bodies)
 {
     impulse_body *A = &bodies[c->a], *B = &bodies[c->b];
-    for (int i = 0; i < c->count; i++) {
+    /* the velocities and the basis in locals: the stores to the points'
+     * doubles would otherwise reload them at every point (same arithmetic,
+     * in impulse_apply's order) */
+    vec3 vA = A->v, wA = A->w, vB = B->v, wB = B->w;
+    const vec3 n = c->n, t1 = c->t1, t2 = c->t2;
+    const double mA = A->inv_mass, mB = B->inv_mass;
+    const int count = c->count, locked = c->locked != 0;
+    for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
-        vec3 P = v3_add(v3_scale(c->n, p->normal_impulse),
-                        v3_add(v3_scale(c->t1, p->tangent_impulse[0]), v3_scale(c->t2, p->tangent_impulse[1])));
+        vec3 P = v3_add(v3_scale(n, p->normal_impulse),
+                        v3_add(v3_scale(t1, p->tangent_impulse[0]), v3_scale(t2, p->tangent_impulse[1])));
         p->total_normal_impulse += p->normal_impulse;
         /* seed convention: body 1 = B receives +P (n points from A to B) */
-        impulse_apply(B, A, c->an[i].rb, c->an[i].ra, P);
-        if (c->locked) {
-            A->v = keep_in_plane(A->v, constraint_lock_a(c));
-            B->v = keep_in_plane(B->v, constraint_lock_b(c));
+        vB = v3_madd(vB, mB, P);
+        wB = v3_add(wB, m3_mulv(B->inv_inertia, v3_cross(c->an[i].rb, P)));
+        vA = v3_madd(vA, -mA, P);
+        wA = v3_sub(wA, m3_mulv(A->inv_inertia, v3_cross(c->an[i].ra, P)));
+        if (locked) {
+            vA = keep_in_plane(vA, constraint_lock_a(c));
+            vB = keep_in_plane(vB, constraint_lock_b(c));
         }
     }
+    A->v = vA; A->w = wA;
+    B->v = vB; B->w = wB;
     if (c->rolling > 0.0) {
         vec3 L = v3_add(v3_scale(c->t1, c->x->rolling_impulse[0]), v3_scale(c->t2, c->x->rolling_impulse[1]));
         A->w = v3_sub(A->w, m3_mulv(A->inv_inertia, L));
