@@ -1902,14 +1902,16 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         if (!within_cube(s->center[i], RANGE_STATE_COORDINATE_MAX)) { bad(r, "body %d is beyond 1e18 m", i); break; }
         quat q = s->rotation[i];
         if (not_unit(q)) { bad(r, "body %d orientation is not unit", i); break; }
-        if (!(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX && v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX)) {
+        /* (a vector its bits say is absent is zero: no length to check) */
+        if (((bits & REC_VELOCITY) && !(v3_len(s->velocity[i]) <= RANGE_SPEED_MAX)) ||
+            ((bits & REC_SPIN) && !(v3_len(s->angular_velocity[i]) <= RANGE_SPEED_MAX))) {
             bad(r, "body %d moves faster than any world allows", i);
             break;
         }
         /* the force bound is the API's loosest (apply_force checks it against
          * the mass then; set_mass may lower the mass later) */
-        if (!(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX) || !(s->sleep_time[i] >= 0) ||
-            !(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX) ||
+        if (((bits & REC_FORCE) && !(v3_len(s->force[i]) <= RANGE_ACCELERATION_MAX * RANGE_MASS_MAX)) || !(s->sleep_time[i] >= 0) ||
+            ((bits & REC_TORQUE) && !(v3_len(s->torque[i]) <= RANGE_ACCELERATION_MAX * RANGE_INERTIA_MAX)) ||
             !(fabs(s->plane_offset[i]) <= RANGE_STATE_COORDINATE_MAX)) {
             bad(r, "body %d force, sleep timer or plane offset out of range", i);
             break;
@@ -1924,7 +1926,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         if (r->failed) break;
         if (!within_cube(s->previous_origin[i], RANGE_STATE_COORDINATE_MAX)) { bad(r, "body %d previous pose is beyond 1e18 m", i); break; }
         quat pq = s->previous_rotation[i];
-        if (not_unit(pq)) {
+        if ((bits & REC_PREVIOUS) && not_unit(pq)) { /* (else it is the orientation, checked above) */
             bad(r, "body %d previous orientation is not unit", i);
             break;
         }
@@ -1935,7 +1937,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         vec3 co = s->collided[i].p;
         quat cq = s->collided[i].q;
         if (!within_cube(co, RANGE_STATE_COORDINATE_MAX) ||
-            not_unit(cq)) {
+            ((bits & REC_COLLIDED) && not_unit(cq))) { /* (else a pose checked above) */
             bad(r, "body %d collided pose is beyond 1e18 m or not unit", i);
             break;
         }
