@@ -39,11 +39,19 @@ typedef struct bp_leaf {
     int tree;
 } bp_leaf;
 
+/* The free nodes, in the order alloc_node hands them out: free_list (the
+ * nodes freed since the pool last grew, last freed first), then the fresh
+ * nodes fresh .. capacity - 1 (lowest first; never written, so a pool grown
+ * by doubling keeps the pages it has not used yet untouched), then
+ * tail_list (every node free when the pool grew). That is the order of one
+ * list holding the new nodes first, then the old list, written out at each
+ * growth (the proxy ids are the same). */
 struct broadphase {
     bp_node *nodes;   /* aligned view into node_block */
     void *node_block;
     bp_leaf *leaves;  /* same capacity as nodes */
     int capacity, free_list, free_count;
+    int fresh, tail_list;
     int root[2];
     int *moved;       /* proxies moved or created since the last bp_update_pairs */
     int move_count, move_capacity;
@@ -54,7 +62,7 @@ broadphase *bp_create(void)
 {
     broadphase *bp = calloc(1, sizeof *bp);
     if (!bp) return NULL;
-    bp->free_list = NULL_NODE;
+    bp->free_list = bp->tail_list = NULL_NODE;
     bp->root[MOVING_TREE] = bp->root[STATIC_TREE] = NULL_NODE;
     return bp;
 }
@@ -87,12 +95,23 @@ static int reserve_nodes(broadphase *bp, int need)
     free(bp->node_block);
     bp->node_block = block;
     bp->nodes = nodes;
-    /* the new nodes go in front of the free list, lowest index first */
-    for (int i = old; i < cap; i++) {
-        nodes[i].parent = i + 1 < cap ? i + 1 : bp->free_list;
+    /* the free nodes so far, written out as one list (free_list, the fresh
+     * ones left, tail_list), go after the new fresh ones */
+    int head = bp->tail_list;
+    for (int i = old - 1; i >= bp->fresh; i--) {
+        nodes[i].parent = head;
         nodes[i].height = -1;
+        head = i;
     }
-    bp->free_list = old;
+    if (bp->free_list != NULL_NODE) {
+        int last = bp->free_list;
+        while (nodes[last].parent != NULL_NODE) last = nodes[last].parent;
+        nodes[last].parent = head;
+        head = bp->free_list;
+    }
+    bp->tail_list = head;
+    bp->free_list = NULL_NODE;
+    bp->fresh = old;
     bp->free_count += cap - old;
     bp->capacity = cap;
     return 1;
@@ -101,10 +120,18 @@ static int reserve_nodes(broadphase *bp, int need)
 /* Only called after reserve_nodes: cannot fail. */
 static int alloc_node(broadphase *bp)
 {
-    int id = bp->free_list;
-    assert(id != NULL_NODE);
+    int id;
+    if (bp->free_list != NULL_NODE) {
+        id = bp->free_list;
+        bp->free_list = bp->nodes[id].parent;
+    } else if (bp->fresh < bp->capacity) {
+        id = bp->fresh++;
+    } else {
+        id = bp->tail_list;
+        assert(id != NULL_NODE);
+        bp->tail_list = bp->nodes[id].parent;
+    }
     bp_node *n = &bp->nodes[id];
-    bp->free_list = n->parent;
     bp->free_count--;
     n->parent = n->child1 = n->child2 = NULL_NODE;
     n->height = 0;
@@ -313,7 +340,7 @@ static void unmark_moved(broadphase *bp, int proxy)
 
 static int is_proxy(const broadphase *bp, int proxy)
 {
-    return bp && proxy >= 0 && proxy < bp->capacity && bp->nodes[proxy].height == 0;
+    return bp && proxy >= 0 && proxy < bp->fresh && bp->nodes[proxy].height == 0; /* (fresh ones are unwritten) */
 }
 
 int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user)
@@ -652,7 +679,7 @@ int bp_validate(const broadphase *bp)
         walk_init(&w, root);
         while (w.count > 0) {
             int i = w.items[--w.count];
-            if (i < 0 || i >= bp->capacity || N[i].height < 0) { walk_free(&w); return 0; }
+            if (i < 0 || i >= bp->fresh || N[i].height < 0) { walk_free(&w); return 0; }
             if (is_leaf(&N[i])) {
                 const bp_leaf *l = &bp->leaves[i];
                 if (N[i].height != 0 || N[i].child2 != NULL_NODE || l->tree != tree) { walk_free(&w); return 0; }
@@ -664,7 +691,7 @@ int bp_validate(const broadphase *bp)
                 continue;
             }
             int a = N[i].child1, b = N[i].child2;
-            int ok = a >= 0 && b >= 0 && a < bp->capacity && b < bp->capacity && N[a].parent == i && N[b].parent == i &&
+            int ok = a >= 0 && b >= 0 && a < bp->fresh && b < bp->fresh && N[a].parent == i && N[b].parent == i &&
                      N[i].height == 1 + max_int(N[a].height, N[b].height);
             if (ok) {
                 aabb u = aabb_union(N[a].box, N[b].box);
@@ -675,8 +702,13 @@ int bp_validate(const broadphase *bp)
         }
         walk_free(&w);
     }
-    int free_nodes = 0;
-    for (int i = bp->free_list; i != NULL_NODE && free_nodes <= bp->capacity; i = N[i].parent) free_nodes++;
+    int free_nodes = bp->capacity - bp->fresh;
+    if (bp->fresh < 0 || free_nodes < 0) return 0;
+    for (int list = 0; list < 2; list++)
+        for (int i = list ? bp->tail_list : bp->free_list; i != NULL_NODE && free_nodes <= bp->capacity; i = N[i].parent) {
+            if (i < 0 || i >= bp->fresh || N[i].height != -1) return 0;
+            free_nodes++;
+        }
     return leaves == bp->proxy_count && moved == bp->move_count && free_nodes == bp->free_count &&
            leaves + internal + free_nodes == bp->capacity;
 }

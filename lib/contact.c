@@ -21,74 +21,104 @@ static uint32_t hash_key(uint64_t k, uint32_t sub)
     return (uint32_t)k;
 }
 
+static uint32_t contact_hash(const contact *c) { return hash_key(pair_key(c->id_a, c->id_b), c->sub); }
+
 static int map_init(pair_map *m, int capacity)
 {
-    m->keys = calloc((size_t)capacity, sizeof *m->keys);
-    m->subs = calloc((size_t)capacity, sizeof *m->subs);
+    m->hashes = malloc((size_t)capacity * sizeof *m->hashes);
     m->values = malloc((size_t)capacity * sizeof *m->values);
     m->capacity = capacity;
     m->count = 0;
-    return m->keys && m->subs && m->values;
+    if (!m->hashes || !m->values) return 0;
+    memset(m->values, 0xff, (size_t)capacity * sizeof *m->values); /* every slot empty (-1) */
+    return 1;
 }
 
-static int map_slot(const pair_map *m, uint64_t key, uint32_t sub)
+static void map_free(pair_map *m)
+{
+    free(m->hashes);
+    free(m->values);
+}
+
+/* The slot holding the contact for (a, b, sub) of hash h, or the empty slot
+ * that ends its probe chain. */
+static int map_slot(const contact_set *cs, uint32_t h, int a, int b, uint32_t sub)
+{
+    const pair_map *m = &cs->map;
+    uint32_t mask = (uint32_t)m->capacity - 1;
+    uint32_t i = h & mask;
+    for (;;) {
+        int v = m->values[i];
+        if (v < 0) return (int)i;
+        if (m->hashes[i] == h) {
+            const contact *c = &cs->items[v];
+            if (c->id_a == a && c->id_b == b && c->sub == sub) return (int)i;
+        }
+        i = (i + 1) & mask;
+    }
+}
+
+/* The first empty slot of h's probe chain (a key known not to be there). */
+static int map_free_slot(const pair_map *m, uint32_t h)
 {
     uint32_t mask = (uint32_t)m->capacity - 1;
-    uint32_t i = hash_key(key, sub) & mask;
-    while (m->keys[i] != 0 && (m->keys[i] != key || m->subs[i] != sub)) i = (i + 1) & mask;
+    uint32_t i = h & mask;
+    while (m->values[i] >= 0) i = (i + 1) & mask;
     return (int)i;
 }
 
-static void map_put(pair_map *m, uint64_t key, uint32_t sub, int value)
+static void map_insert(pair_map *m, uint32_t h, int value)
 {
-    int i = map_slot(m, key, sub);
-    if (m->keys[i] == 0) m->count++;
-    m->keys[i] = key;
-    m->subs[i] = sub;
+    int i = map_free_slot(m, h);
+    m->hashes[i] = h;
     m->values[i] = value;
+    m->count++;
 }
 
 static int map_grow(pair_map *m)
 {
     pair_map n;
     if (!map_init(&n, m->capacity * 2)) {
-        free(n.keys);
-        free(n.subs);
-        free(n.values);
+        map_free(&n);
         return 0;
     }
     for (int i = 0; i < m->capacity; i++)
-        if (m->keys[i]) map_put(&n, m->keys[i], m->subs[i], m->values[i]);
-    free(m->keys);
-    free(m->subs);
-    free(m->values);
+        if (m->values[i] >= 0) map_insert(&n, m->hashes[i], m->values[i]);
+    map_free(m);
     *m = n;
     return 1;
 }
 
-/* Backward-shift deletion keeps probe chains intact without tombstones. */
-static void map_remove(pair_map *m, uint64_t key, uint32_t sub)
+/* Empties slot i; backward-shift deletion keeps probe chains intact without
+ * tombstones. */
+static void map_erase(pair_map *m, uint32_t i)
 {
     uint32_t mask = (uint32_t)m->capacity - 1;
-    uint32_t i = (uint32_t)map_slot(m, key, sub);
-    if (m->keys[i] == 0) return;
-    m->keys[i] = 0;
+    m->values[i] = -1;
     m->count--;
     uint32_t j = i;
     for (;;) {
         j = (j + 1) & mask;
-        if (m->keys[j] == 0) return;
-        uint32_t home = hash_key(m->keys[j], m->subs[j]) & mask;
+        if (m->values[j] < 0) return;
+        uint32_t home = m->hashes[j] & mask;
         /* move j back to i unless its home lies cyclically in (i, j] */
         int keep = (i <= j) ? (i < home && home <= j) : (i < home || home <= j);
         if (!keep) {
-            m->keys[i] = m->keys[j];
-            m->subs[i] = m->subs[j];
+            m->hashes[i] = m->hashes[j];
             m->values[i] = m->values[j];
-            m->keys[j] = 0;
+            m->values[j] = -1;
             i = j;
         }
     }
+}
+
+/* The slot whose value is contact index `value` (of hash h): it is in the map. */
+static uint32_t map_slot_of(const pair_map *m, uint32_t h, int value)
+{
+    uint32_t mask = (uint32_t)m->capacity - 1;
+    uint32_t i = h & mask;
+    while (m->values[i] != value) i = (i + 1) & mask;
+    return i;
 }
 
 int contact_set_init(contact_set *cs)
@@ -97,15 +127,19 @@ int contact_set_init(contact_set *cs)
     if (!array_reserve((void **)&cs->data, &cs->data_capacity, 1, sizeof *cs->data)) return 0;
     memset(&cs->data[0], 0, sizeof cs->data[0]);
     cs->data_count = 1;
-    return map_init(&cs->map, 64);
+    if (map_init(&cs->map, 64)) return 1;
+    map_free(&cs->map);
+    return 0;
 }
 
 int contact_data_alloc(contact_set *cs, int i)
 {
     if (cs->items[i].slot) return 1;
     int slot;
-    if (cs->free_count > 0) {
-        slot = cs->data_free[--cs->free_count];
+    if (cs->free_head) {
+        slot = cs->free_head;
+        cs->free_head = contact_data_next_free(cs, slot);
+        cs->free_count--;
     } else {
         if (!array_reserve((void **)&cs->data, &cs->data_capacity, cs->data_count + 1, sizeof *cs->data)) return 0;
         slot = cs->data_count++;
@@ -121,8 +155,18 @@ void contact_data_release(contact_set *cs, int i)
     if (!slot) return;
     cs->items[i].slot = 0;
     if (slot == cs->data_count - 1) { cs->data_count--; return; }
-    /* room for every slot was reserved when the slot was made (below): cannot fail */
-    cs->data_free[cs->free_count++] = slot;
+    /* the free list runs through the free slots themselves: no array of its
+     * own (one int per contact ever made, 1 MB resident at 50,000 bodies) */
+    memcpy(&cs->data[slot], &cs->free_head, sizeof cs->free_head);
+    cs->free_head = slot;
+    cs->free_count++;
+}
+
+int contact_data_next_free(const contact_set *cs, int slot)
+{
+    int next;
+    memcpy(&next, &cs->data[slot], sizeof next);
+    return next;
 }
 
 static int bits_zero(vec3 v)
@@ -143,18 +187,14 @@ void contact_set_free(contact_set *cs)
 {
     free(cs->items);
     free(cs->data);
-    free(cs->data_free);
-    free(cs->map.keys);
-    free(cs->map.subs);
-    free(cs->map.values);
+    map_free(&cs->map);
     memset(cs, 0, sizeof *cs);
 }
 
 int contact_find_sub(const contact_set *cs, int a, int b, uint32_t sub)
 {
-    uint64_t key = pair_key(a, b);
-    int i = map_slot(&cs->map, key, sub);
-    return cs->map.keys[i] == key ? cs->map.values[i] : -1;
+    if (a > b) { int t = a; a = b; b = t; }
+    return cs->map.values[map_slot(cs, hash_key(pair_key(a, b), sub), a, b, sub)];
 }
 
 int contact_find(const contact_set *cs, int a, int b) { return contact_find_sub(cs, a, b, 0); }
@@ -180,7 +220,6 @@ void contact_set_trim(contact_set *cs)
 int contact_append(contact_set *cs, int a, int b, uint32_t sub)
 {
     if (!array_reserve((void **)&cs->items, &cs->capacity, cs->count + 1, sizeof *cs->items)) return -1;
-    if (!array_reserve((void **)&cs->data_free, &cs->free_capacity, cs->count + 1, sizeof *cs->data_free)) return -1;
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);
@@ -202,64 +241,61 @@ int contact_set_index(contact_set *cs, int *repeated)
     int ok = map_init(&m, capacity);
     int *start = calloc((size_t)capacity + 1, sizeof *start);
     int *order = malloc(sizeof *order * (size_t)(n > 0 ? n : 1));
-    uint32_t *home = malloc(sizeof *home * (size_t)(n > 0 ? n : 1));
-    if (!ok || !start || !order || !home) {
-        free(m.keys);
-        free(m.subs);
-        free(m.values);
+    uint32_t *hash = malloc(sizeof *hash * (size_t)(n > 0 ? n : 1));
+    if (!ok || !start || !order || !hash) {
+        map_free(&m);
         free(start);
         free(order);
-        free(home);
+        free(hash);
         return 0;
     }
     /* the contacts by home slot (counting sort, stable) */
     for (int i = 0; i < n; i++) {
-        home[i] = hash_key(pair_key(cs->items[i].id_a, cs->items[i].id_b), cs->items[i].sub) & mask;
-        start[home[i] + 1]++;
+        hash[i] = contact_hash(&cs->items[i]);
+        start[(hash[i] & mask) + 1]++;
     }
     for (int k = 0; k < capacity; k++) start[k + 1] += start[k];
-    for (int i = 0; i < n; i++) order[start[home[i]]++] = i;
+    for (int i = 0; i < n; i++) order[start[hash[i] & mask]++] = i;
+    pair_map old = cs->map;
+    cs->map = m; /* map_slot reads the set's map */
     for (int k = 0; k < n; k++) {
         int i = order[k];
-        uint64_t key = pair_key(cs->items[i].id_a, cs->items[i].id_b);
-        int slot = map_slot(&m, key, cs->items[i].sub);
-        if (m.keys[slot] == key) { /* the later of the two repeats the earlier */
-            int later = i > m.values[slot] ? i : m.values[slot];
+        const contact *c = &cs->items[i];
+        int slot = map_slot(cs, hash[i], c->id_a, c->id_b, c->sub);
+        if (cs->map.values[slot] >= 0) { /* the later of the two repeats the earlier */
+            int later = i > cs->map.values[slot] ? i : cs->map.values[slot];
             if (*repeated < 0 || later < *repeated) *repeated = later;
             continue;
         }
-        m.keys[slot] = key;
-        m.subs[slot] = cs->items[i].sub;
-        m.values[slot] = i;
-        m.count++;
+        cs->map.hashes[slot] = hash[i];
+        cs->map.values[slot] = i;
+        cs->map.count++;
     }
     free(start);
     free(order);
-    free(home);
-    free(cs->map.keys);
-    free(cs->map.subs);
-    free(cs->map.values);
-    cs->map = m;
+    free(hash);
+    map_free(&old);
     return 1;
 }
 
+/* (a new pair: the caller found none for it) */
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
     if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
     int i = contact_append(cs, a, b, sub);
-    if (i >= 0) map_put(&cs->map, pair_key(a, b), sub, i);
+    if (i >= 0) map_insert(&cs->map, contact_hash(&cs->items[i]), i);
     return i;
 }
 
 void contact_remove(contact_set *cs, int i)
 {
     contact *c = &cs->items[i];
-    map_remove(&cs->map, pair_key(c->id_a, c->id_b), c->sub);
+    map_erase(&cs->map, map_slot_of(&cs->map, contact_hash(c), i));
     contact_data_release(cs, i);
     int last = cs->count - 1;
     if (i != last) {
         cs->items[i] = cs->items[last]; /* (its data stays in its slot) */
-        map_put(&cs->map, pair_key(cs->items[i].id_a, cs->items[i].id_b), cs->items[i].sub, i);
+        cs->map.values[map_slot_of(&cs->map, contact_hash(&cs->items[i]), last)] = i;
     }
     cs->count--;
 }

@@ -55,11 +55,13 @@ typedef struct contact_data {
     vec3 normal_a;              /* the manifold normal in A's frame when computed */
 } contact_data;
 
-/* Open-addressing map from an ordered pair of id indices to a contact index. */
+/* Open-addressing map from an ordered pair of id indices and a sub to a
+ * contact index. A slot holds the key's 32-bit hash and the contact (8
+ * bytes; the key itself is the contact's id_a, id_b and sub, compared when
+ * the hashes agree): half the bytes of a slot that kept the key. */
 typedef struct pair_map {
-    uint64_t *keys;             /* 0 = empty; key = ((a+1) << 32) | (b+1) */
-    uint32_t *subs;             /* with the key: the contact's sub */
-    int *values;
+    uint32_t *hashes;           /* hash_key of the slot's contact */
+    int *values;                /* contact index; -1 = empty */
     int capacity;               /* power of two */
     int count;
 } pair_map;
@@ -68,8 +70,9 @@ typedef struct contact_set {
     contact *items;
     contact_data *data;         /* the pool: data[0] stays all zeros (a slotless pair reads it) */
     int count, capacity, data_count, data_capacity;
-    int *data_free;             /* slots given back, reused last in first out */
-    int free_count, free_capacity;
+    int free_head;              /* slots given back, reused last in first out: the last one given back
+                                   (0: none), each holding the next in its first bytes (contact_data_next_free) */
+    int free_count;
     pair_map map;
 } contact_set;
 
@@ -80,6 +83,9 @@ typedef struct contact_set {
 int contact_data_alloc(contact_set *cs, int i);
 /* Gives contact i's slot back (it reads the empty record after). */
 void contact_data_release(contact_set *cs, int i);
+/* The free slot given back before `slot` (a free slot; 0: none): the free
+ * slots are free_head, then each one's next. */
+int contact_data_next_free(const contact_set *cs, int slot);
 /* Whether contact i's data holds nothing a zeroed record with the pair's
  * mixed material would not: no points, no kept friction basis, and no flag
  * under which its normal or A-frame normal is read. The material is left to

@@ -419,6 +419,21 @@ static void fill_constraints_range(int begin, int end, int worker, void *p)
     for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
 }
 
+/* The solver block's bytes (build_constraints): ncon constraints, then
+ * their npoints points packed (most pairs of round shapes have one point, so
+ * a fixed 4 per constraint would waste cache), the shock and contact lists
+ * over nb bodies, then from *block_at (64-byte aligned) the scalar passes'
+ * blocks (contact_prepare fills those of the manifolds it prepares; the wide
+ * ones' stay untouched, so their pages are never resident). */
+static size_t solver_block_bytes(int ncon, int npoints, int nb, size_t *block_at)
+{
+    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
+                       sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
+    size_t at = (con_bytes + 63) / 64 * 64;
+    if (block_at) *block_at = at;
+    return at + sizeof(contact_block) * (size_t)ncon;
+}
+
 /* The order the manifolds are solved in, from the geometry alone, so a scene
  * gives the same results whatever order its bodies were created in (the
  * contact set's order follows creation): bottom-up by the height of the
@@ -574,9 +589,17 @@ static int sort_touching(carom_world *w, const step_context *ctx)
         if (n == 1) sm->points[0] = CONTACT_DATA(&w->contacts, s->touching[0])->m.count;
         return 1;
     }
-    /* keys, then merge space, then the hinted order */
-    if (!array_reserve(&sm->order, &sm->order_capacity, 3 * n, sizeof(order_key))) return 0;
-    order_key *keys = sm->order;
+    /* keys, then merge space, then the hinted order: at the start of the
+     * solver block, which build_constraints fills with the constraints once
+     * the keys are dead, so the keys' pages are the constraints' (a block of
+     * their own was 12 MB resident at 50,000 bodies, 250 B a body). The block
+     * is reserved for the constraints too, their points at most 4 a manifold,
+     * so that build_constraints does not move it. */
+    size_t key_bytes = sizeof(order_key) * 3 * (size_t)n, block_bytes = solver_block_bytes(n, MANIFOLD_MAX_POINTS * n,
+                                                                                           ctx->body_count, NULL);
+    if (!array_reserve(&sm->block, &sm->block_capacity, (int)(key_bytes > block_bytes ? key_bytes : block_bytes), 1))
+        return 0;
+    order_key *keys = sm->block;
     key_job job;
     job.w = w;
     job.keys = keys;
@@ -642,14 +665,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     int ncon = s->touching_count, npoints = 0, nb = ctx->body_count;
     const int *points = s->solver.points;
     for (int c = 0; c < ncon; c++) npoints += points[c];
-    /* one block: constraints, then their points packed (most pairs of round
-     * shapes have one point, so a fixed 4 per constraint would waste cache) */
-    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
-                       sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
-    /* last, after the lists: the scalar passes' blocks (contact_prepare
-     * fills those of the manifolds it prepares; the wide ones' stay untouched) */
-    size_t block_at = (con_bytes + 63) / 64 * 64;
-    size_t all_bytes = block_at + sizeof(contact_block) * (size_t)ncon;
+    size_t block_at, all_bytes = solver_block_bytes(ncon, npoints, nb, &block_at);
     if (!array_reserve(&s->solver.block, &s->solver.block_capacity, (int)all_bytes, 1)) return 0;
     contact_constraint *cc = s->solver.block;
     constraint_point *point_pool = (constraint_point *)(cc + ncon);
@@ -1137,7 +1153,6 @@ void solver_memory_free(solver_memory *m)
     free(m->springs);
     free(m->extra);
     free(m->wide);
-    free(m->order);
     free(m->points);
     free(m->hit);
     free(m->last_order);

@@ -7,7 +7,8 @@
 
 /* The solver's memory, kept between steps in the world's scratch. */
 typedef struct solver_memory {
-    void *block;                 /* constraints, their points, shock and contact lists */
+    void *block;                 /* constraints, their points, shock and contact lists (before them in
+                                    the step: sort_touching's keys) */
     int block_capacity;
     void *anchors;               /* the scalar and shock passes' anchors (constraint_anchor) */
     int anchors_capacity;
@@ -20,8 +21,6 @@ typedef struct solver_memory {
     void *wide;                  /* solver_wide.c's batches */
     size_t wide_capacity;
     int wide_env;                /* wide_read_env's switches (0: not read yet) */
-    void *order;                 /* the manifolds' solve-order keys (sort_touching) */
-    int order_capacity;
     int *points;                 /* this step: each touching manifold's point count, in solve order */
     int points_capacity;
     unsigned char *hit;          /* this step: per constraint, 1 when it raises a hit event (store_impulses) */

@@ -271,11 +271,13 @@ static void check_slots(const carom_world *w, int step, int *with, int *without)
             fail();
         }
     }
-    for (int k = 0; k < cs->free_count; k++) {
-        int slot = cs->data_free[k];
-        assert_true(slot > 0 && slot < cs->data_count);
+    int listed = 0;
+    for (int slot = cs->free_head; slot; slot = contact_data_next_free(cs, slot)) {
+        assert_true(slot > 0 && slot < cs->data_count && listed < cs->free_count);
         if (owner[slot]++) { print_error("step %d: free slot %d in use\n", step, slot); fail(); }
+        listed++;
     }
+    assert_int_equal(listed, cs->free_count);
     assert_int_equal(used + cs->free_count, cs->data_count - 1);
     free(owner);
 }
