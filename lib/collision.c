@@ -84,7 +84,7 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     body_store *s = &w->bodies;
     step_scratch *sc = &w->scratch;
     double dt = ctx->dt;
-    if (!array_reserve((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
+    if (!array_reserve_near((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
     /* the pose array shares the capacity: grow it to match */
     int cap = sc->slot_capacity;
     void *grown = realloc(sc->pose, sizeof *sc->pose * (size_t)(cap > 0 ? cap : 1));
@@ -114,7 +114,7 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     int np = sc->new_pair_count;
     if (np > 1) {
         /* the merge space after the keys; without it (out of memory) qsort */
-        if (array_reserve((void **)&sc->new_pairs, &sc->new_pair_capacity, 2 * np, sizeof *sc->new_pairs))
+        if (array_reserve_near((void **)&sc->new_pairs, &sc->new_pair_capacity, 2 * np, sizeof *sc->new_pairs))
             sort_pairs(sc->new_pairs, sc->new_pairs + np, np);
         else
             qsort(sc->new_pairs, (size_t)np, sizeof *sc->new_pairs, compare_pairs);
@@ -544,10 +544,10 @@ int world_collide(carom_world *w, const step_context *ctx)
     sc->mixed_count = 0;
     sc->asleep_pair_count = 0;
     /* at most every contact is touching (or asleep): reserve once, so nothing below can fail */
-    if (!array_reserve((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching) ||
-        !array_reserve((void **)&sc->mixed, &sc->mixed_capacity, cs->count, sizeof *sc->mixed))
+    if (!array_reserve_near((void **)&sc->touching, &sc->touching_capacity, cs->count, sizeof *sc->touching) ||
+        !array_reserve_near((void **)&sc->mixed, &sc->mixed_capacity, cs->count, sizeof *sc->mixed))
         return 0;
-    if (!array_reserve((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
+    if (!array_reserve_near((void **)&sc->asleep_pairs, &sc->asleep_pair_capacity, cs->count, sizeof *sc->asleep_pairs))
         return 0;
     /* on one worker the pass below does the same work in place */
     if (tasks_workers(&w->def) > 1) {

@@ -10,15 +10,15 @@
 #include "step.h"
 
 /* A point as every manifold has it: what the stages after the passes read
- * (impacts, impulse storage, hit and force events). Its anchors are in
- * constraint_anchor, the rows the scalar passes solve in constraint_rows; a
- * wide-solved manifold's anchors and rows live only in its batch's lanes
- * (solver_wide.c), and its anchors also here when the shock pass runs. */
-typedef struct constraint_point {
-    double normal_impulse, tangent_impulse[2];
-    double total_normal_impulse;
-    double relative_velocity;    /* normal velocity before solving (restitution, hit events) */
-} constraint_point;
+ * (impacts, impulse storage, hit and force events): normal_impulse,
+ * tangent_impulse, total_normal_impulse, relative_velocity. It is the
+ * contact's own point state (contact.h): the impulses a step starts from
+ * are last step's (warm), which prepare reads before it writes them. Its
+ * anchors are in constraint_anchor, the rows the scalar passes solve in
+ * constraint_rows; a wide-solved manifold's anchors and rows live only in
+ * its batch's lanes (solver_wide.c), and its anchors also here when the
+ * shock pass runs. */
+typedef contact_point_state constraint_point;
 
 /* A point's separation and anchors: the scalar passes' and the shock pass's. */
 typedef struct constraint_anchor {
@@ -68,14 +68,14 @@ typedef struct contact_constraint {
     double friction, restitution;
     double rolling;              /* rolling resistance (0: no rolling rows, the manifold may go wide) */
     softness soft;
-    constraint_point *p;         /* count points in the step's packed point array */
+    constraint_point *p;         /* its count points: the contact's point states, holding last step's
+                                    impulses (matched by feature) until prepare scales them in place */
     constraint_anchor *an;       /* their anchors: scalar passes, and every manifold when the shock pass runs; else NULL */
     constraint_rows *r;          /* their rows: scalar passes only (NULL for a wide-solved manifold) */
     penalty_spring *spring;      /* their springs: penalty model only, else NULL */
     constraint_extra *x;         /* locked or rolling manifolds only, else NULL */
     /* what preparing the points reads */
     const manifold *m;
-    const contact_point_state *warm; /* last step's impulses, matched by feature */
     vec3 center_a, center_b;     /* centres of mass */
     double gravity_closing;      /* normal acceleration of b relative to a from gravity and forces */
 } contact_constraint;

@@ -20,11 +20,18 @@ enum {
     CONTACT_PRECOMPUTED_TOUCHING = 1u << 7
 };
 
+/* A point's state. Its first five fields are also the solver's point
+ * (constraint_point, constraint.h): a solved manifold's points live here
+ * during the step, not in a per-step copy (40 B a point, 420 B a body at
+ * 50,000 bodies), so the impulses the solver leaves are already the next
+ * step's warm start. */
 typedef struct contact_point_state {
-    double normal_impulse;      /* accumulated (per sub-step), for warm starting */
+    double normal_impulse;      /* accumulated (per sub-step): warm starting; the solver's own in a step */
     double tangent_impulse[2];
-    vec3 local_a;               /* point in A's body frame when the manifold was computed */
-    double separation;          /* its separation then (a reused manifold updates from it) */               /* point in A's body frame (fallback matching) */
+    double total_normal_impulse; /* the step's, over its sub-steps (restitution, hit and force events) */
+    double relative_velocity;   /* the step's normal velocity before solving (restitution, hit events) */
+    vec3 local_a;               /* point in A's body frame when the manifold was computed (fallback matching) */
+    double separation;          /* its separation then (a reused manifold updates from it) */
 } contact_point_state;
 
 /* What the collision stage reads for every broadphase pair, touching or not

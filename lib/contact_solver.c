@@ -255,7 +255,7 @@ static int block_loaded_softness(const contact_constraint *c, const step_context
     if (!(ctx->relax_iterations > 0 && ctx->warm_starting && ctx->gravity_length > 0.0 && mA + mB > 0.0)) return 0;
     if (c->soft.mass_scale == 1.0 && c->soft.impulse_scale == 0.0) return 0; /* held rigidly (touching impact) */
     double load = 0.0;
-    for (int j = 0; j < c->count; j++) load += c->warm[j].normal_impulse;
+    for (int j = 0; j < c->count; j++) load += c->p[j].normal_impulse; /* last step's (warm starting on) */
     double ratio = load * (mA + mB) / (ctx->h * ctx->gravity_length);
     /* past 1/(4h) only with two iterations or more: at one the sweeps would
      * run nearly everywhere (the 10-box stack at default: 137.6M -> 258.5M
@@ -451,9 +451,9 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         q->base_separation = mp->separation;
         p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, q->rb, q->ra, c->n),
                                                          c->gravity_closing, mp->separation);
-        p->normal_impulse = ws * c->warm[j].normal_impulse;
-        p->tangent_impulse[0] = ws * c->warm[j].tangent_impulse[0];
-        p->tangent_impulse[1] = ws * c->warm[j].tangent_impulse[1];
+        p->normal_impulse = ws * p->normal_impulse; /* last step's, in place (constraint.h) */
+        p->tangent_impulse[0] = ws * p->tangent_impulse[0];
+        p->tangent_impulse[1] = ws * p->tangent_impulse[1];
         p->total_normal_impulse = 0.0;
         if (ctx->penalty) penalty_prepare_point(p, r, &c->spring[j], ctx);
         if (-mp->separation > deepest) deepest = -mp->separation;

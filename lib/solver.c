@@ -18,7 +18,8 @@
  *     relax                unbiased passes, then the shock pass
  *   store_wide             the batches' impulses back to the points
  *   finish_impacts         bounced bodies keep the rest of the step (impact.c)
- *   store_impulses         for next step's warm start
+ *   store_impulses         the hit-event flags (the impulses are already the contacts'
+ *                          point states: next step's warm start)
  *   raise_hit_events       impacts above the threshold
  *   events_raise_forces    pairs pressed above a body's force threshold (events.c)
  *   finish_bodies          velocities written back, clamps, NaN guard, inertia
@@ -191,7 +192,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     step_scratch *s = &w->scratch;
     double wmax = world_spin_clamp(&w->def, ctx->h);
     for (int i = 0; i < bs->count; i++) bs->solver_index[i] = 0;
-    if (!array_reserve((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
+    if (!array_reserve_near((void **)&s->body_slot, &s->body_capacity, bs->count + 1, sizeof *s->body_slot)) return 0;
     /* the per-body scratch arrays share one capacity */
     int cap = s->body_capacity;
     if (cap > s->solver.bodies_capacity || !s->bodies) {
@@ -214,7 +215,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     void *p4 = realloc(s->inertia_start, sizeof *s->inertia_start * (size_t)cap);
     if (!p4) return 0;
     s->inertia_start = p4;
-    if (!array_reserve(&s->solver.motion, &s->solver.motion_capacity, cap, sizeof(body_step))) return 0;
+    if (!array_reserve_near(&s->solver.motion, &s->solver.motion_capacity, cap, sizeof(body_step))) return 0;
     body_step *motion = s->solver.motion;
     motion[0].flags = STEP_KINEMATIC;
     impulse_body *bodies = s->bodies;
@@ -364,7 +365,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
     c->soft = loaded_softness(ctx, ls, &bodies[c->a], &bodies[c->b], cd->state, cd->m.count);
     c->wide_batch = -1;
     c->m = &cd->m;
-    c->warm = cd->state;
+    c->p = cd->state; /* solved in place: last step's impulses until prepare scales them */
     c->center_a = bs->center[sa];
     c->center_b = bs->center[sb];
     /* plane normals (attach_extras): a moving body's, when it is locked to a plane
@@ -419,16 +420,14 @@ static void fill_constraints_range(int begin, int end, int worker, void *p)
     for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
 }
 
-/* The solver block's bytes (build_constraints): ncon constraints, then
- * their npoints points packed (most pairs of round shapes have one point, so
- * a fixed 4 per constraint would waste cache), the shock and contact lists
- * over nb bodies, then from *block_at (64-byte aligned) the scalar passes'
+/* The solver block's bytes (build_constraints): ncon constraints (their
+ * points are the contacts' own, contact_point_state), the shock and contact
+ * lists over nb bodies, then from *block_at (64-byte aligned) the scalar passes'
  * blocks (contact_prepare fills those of the manifolds it prepares; the wide
  * ones' stay untouched, so their pages are never resident). */
-static size_t solver_block_bytes(int ncon, int npoints, int nb, size_t *block_at)
+static size_t solver_block_bytes(int ncon, int nb, size_t *block_at)
 {
-    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(constraint_point) * (size_t)npoints +
-                       sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
+    size_t con_bytes = sizeof(contact_constraint) * (size_t)ncon + sizeof(int) * (size_t)(3 * ncon + 3 * nb + 4);
     size_t at = (con_bytes + 63) / 64 * 64;
     if (block_at) *block_at = at;
     return at + sizeof(contact_block) * (size_t)ncon;
@@ -536,8 +535,8 @@ static void keep_hint(solver_memory *sm, const int *touching, int n, int contact
 {
     sm->last_count = 0;
     int had = sm->mark_capacity;
-    if (!array_reserve((void **)&sm->last_order, &sm->last_capacity, n, sizeof *sm->last_order) ||
-        !array_reserve((void **)&sm->mark, &sm->mark_capacity, contacts, sizeof *sm->mark))
+    if (!array_reserve_near((void **)&sm->last_order, &sm->last_capacity, n, sizeof *sm->last_order) ||
+        !array_reserve_near((void **)&sm->mark, &sm->mark_capacity, contacts, sizeof *sm->mark))
         return;
     if (sm->mark_capacity > had) memset(sm->mark + had, 0, sizeof *sm->mark * (size_t)(sm->mark_capacity - had));
     memcpy(sm->last_order, touching, sizeof *touching * (size_t)n);
@@ -584,7 +583,7 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     step_scratch *s = &w->scratch;
     solver_memory *sm = &s->solver;
     int n = s->touching_count;
-    if (!array_reserve((void **)&sm->points, &sm->points_capacity, n > 0 ? n : 1, sizeof *sm->points)) return 0;
+    if (!array_reserve_near((void **)&sm->points, &sm->points_capacity, n > 0 ? n : 1, sizeof *sm->points)) return 0;
     if (n < 2) {
         if (n == 1) sm->points[0] = CONTACT_DATA(&w->contacts, s->touching[0])->m.count;
         return 1;
@@ -593,10 +592,9 @@ static int sort_touching(carom_world *w, const step_context *ctx)
      * solver block, which build_constraints fills with the constraints once
      * the keys are dead, so the keys' pages are the constraints' (a block of
      * their own was 12 MB resident at 50,000 bodies, 250 B a body). The block
-     * is reserved for the constraints too, their points at most 4 a manifold,
-     * so that build_constraints does not move it. */
-    size_t key_bytes = sizeof(order_key) * 3 * (size_t)n, block_bytes = solver_block_bytes(n, MANIFOLD_MAX_POINTS * n,
-                                                                                           ctx->body_count, NULL);
+     * is reserved for the constraints too, so that build_constraints does not
+     * move it. */
+    size_t key_bytes = sizeof(order_key) * 3 * (size_t)n, block_bytes = solver_block_bytes(n, ctx->body_count, NULL);
     if (!array_reserve(&sm->block, &sm->block_capacity, (int)(key_bytes > block_bytes ? key_bytes : block_bytes), 1))
         return 0;
     order_key *keys = sm->block;
@@ -665,18 +663,13 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     int ncon = s->touching_count, npoints = 0, nb = ctx->body_count;
     const int *points = s->solver.points;
     for (int c = 0; c < ncon; c++) npoints += points[c];
-    size_t block_at, all_bytes = solver_block_bytes(ncon, npoints, nb, &block_at);
+    size_t block_at, all_bytes = solver_block_bytes(ncon, nb, &block_at);
     if (!array_reserve(&s->solver.block, &s->solver.block_capacity, (int)all_bytes, 1)) return 0;
     contact_constraint *cc = s->solver.block;
-    constraint_point *point_pool = (constraint_point *)(cc + ncon);
-    work->shock_order = (int *)(point_pool + npoints);
+    work->shock_order = (int *)(cc + ncon);
     work->level = work->shock_order + ncon;
     work->level_count = work->level + nb + 1;
     work->in_contact = work->level_count + nb + 3;
-    for (int k = 0; k < ncon; k++) {
-        cc[k].p = point_pool;
-        point_pool += points[k];
-    }
     constraint_job job = {w, ctx, cc, NULL};
     tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
     if (!attach_extras(w, ctx, cc, ncon, &work->locked)) return 0;
@@ -991,32 +984,20 @@ typedef struct impulse_job {
     unsigned char *hit;          /* per constraint: hit_of (NULL: raise_hit_events tests them itself) */
 } impulse_job;
 
-/* The impulses back to the contacts, and (while the points are at hand:
- * a second pass over them was a tenth of world_solve's own time at 50,000
- * bodies) which manifolds raise a hit event. */
+/* Which manifolds raise a hit event. (The impulses are already the
+ * contacts': a manifold's points are its contact's point states.) */
 static void store_impulses_range(int begin, int end, int worker, void *p)
 {
     const impulse_job *job = p;
     /* locals: the byte stores to hit may alias anything */
-    const contact_set *cs = &job->w->contacts;
     const contact_constraint *cc = job->cc;
     unsigned char *hit = job->hit;
     double threshold = job->ctx->hit_event_threshold;
     (void)worker;
     for (int c = begin; c < end; c++) {
-        const contact_constraint *con = &cc[c];
-        contact_data *cd = CONTACT_DATA(cs, con->contact);
-        for (int j = 0; j < con->count; j++) {
-            const constraint_point *p = &con->p[j];
-            cd->state[j].normal_impulse = p->normal_impulse;
-            cd->state[j].tangent_impulse[0] = p->tangent_impulse[0];
-            cd->state[j].tangent_impulse[1] = p->tangent_impulse[1];
-        }
-        if (hit) {
-            double approach, total;
-            int deepest;
-            hit[c] = (unsigned char)hit_of(con, threshold, &approach, &total, &deepest);
-        }
+        double approach, total;
+        int deepest;
+        hit[c] = (unsigned char)hit_of(&cc[c], threshold, &approach, &total, &deepest);
     }
 }
 
@@ -1026,7 +1007,8 @@ static const unsigned char *store_impulses(carom_world *w, const step_context *c
     solver_memory *sm = &w->scratch.solver;
     int n = ctx->constraint_count;
     impulse_job job = {w, ctx, ctx->constraints, NULL};
-    if (array_reserve((void **)&sm->hit, &sm->hit_capacity, n > 0 ? n : 1, sizeof *sm->hit)) job.hit = sm->hit;
+    if (!array_reserve_near((void **)&sm->hit, &sm->hit_capacity, n > 0 ? n : 1, sizeof *sm->hit)) return NULL;
+    job.hit = sm->hit;
     tasks_run(ctx->tasks, n, CONSTRAINT_MIN_RANGE, store_impulses_range, &job);
     return job.hit;
 }

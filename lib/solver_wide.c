@@ -902,11 +902,11 @@ LANE_INLINE void gather_point(const lane_manifolds *lm, int i, const contact_poi
                               lane_t rb[3], lane_t *sep)
 {
     static const manifold_point no_point = {{0, 0, 0}, 0, 0};
-    static const contact_point_state no_state = {0, {0, 0}, {0, 0, 0}, 0};
+    static const contact_point_state no_state = {.normal_impulse = 0.0};
     const manifold_point *mp[LANES];
     for (int l = 0; l < LANES; l++) {
         mp[l] = lm->c[l] ? &lm->c[l]->m->points[i] : &no_point;
-        st[l] = lm->c[l] ? &lm->c[l]->warm[i] : &no_state;
+        st[l] = lm->c[l] ? &lm->c[l]->p[i] : &no_state;
     }
     lane_t point[3];
     gather_vec(point, mp[0]->point, mp[1]->point, mp[2]->point, mp[3]->point);
