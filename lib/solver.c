@@ -776,7 +776,8 @@ static void prepare_points(const step_context *ctx, solver_work *work)
         contact_constraint *c = scalar_constraint(ctx, work, k);
         work->max_penetration = dmax(work->max_penetration, contact_prepare(c, ctx));
         if (!work->wide) work->points += c->count;
-        if (ctx->blocks) work->stiff += ctx->blocks[c - ctx->constraints].stiff;
+        /* the penalty model prepares no blocks (contact_prepare) */
+        if (ctx->blocks && !ctx->penalty) work->stiff += ctx->blocks[c - ctx->constraints].stiff;
     }
 }
 
