@@ -6,11 +6,12 @@
  * that share no moving body in one colour; within a colour, manifolds with
  * the same number of points are packed four to a batch, field by field. Each
  * manifold is still solved point by point exactly as in solver.c; only the
- * order between manifolds becomes colour by colour. Manifolds with a
- * plane-locked body take batches of their own, whose passes keep the locked
- * velocities in their planes, and so do manifolds whose bodies cannot turn
- * (static or rotation-locked), whose passes solve only the linear terms
- * (a switch that removes work saves it). Manifolds beyond
+ * order between manifolds becomes colour by colour. Manifolds take batches
+ * of their own kind (a switch that removes work saves it): with a
+ * plane-locked body beside a free one (the locked velocities kept in their
+ * planes after every row), with every body static or locked to a plane
+ * (three degrees of freedom a body: the planar rows), and with no body that
+ * can turn (static or rotation-locked: the linear rows). Manifolds beyond
  * the last colour, or with rolling resistance, keep the scalar passes
  * (contact_solver.c). The AVX2 and SSE2 builds
  * of the passes come from one source (WIDE_PASSES below), each for two row
@@ -85,6 +86,29 @@ typedef struct wide_lpoint {
     lane_t tangent_mass[2], tangent_impulse[2];
 } wide_lpoint;
 
+/* The point of a planar batch (WIDE_KIND_PLANAR), 112 bytes a point: a body
+ * locked to a plane with normal l moves in it and turns about l only, so
+ * each row's angular part is one number per body, the arm's (r x d).l, and
+ * its response through the inverse inertia (k l l^T, body.c) is k times it
+ * about l. The static body has l = 0: no angular part. */
+typedef struct wide_ppoint {
+    lane_t base_separation, normal_mass, normal_impulse;
+    lane_t total_normal_impulse;
+    lane_t tangent_mass[2], tangent_impulse[2];
+    lane_t ja_n, jb_n, ja_t[2], jb_t[2]; /* (r x d).l for d = n, t1, t2 */
+} wide_ppoint;
+
+/* A planar batch's bodies per lane: the plane normals (zero: the static
+ * body), each row direction's part in each body's plane, d - (d.l) l (what
+ * an impulse along d moves the body by, per unit of 1/m: its velocity stays
+ * in the plane without a projection after each row), and each body's
+ * inverse moment about its normal. */
+typedef struct wide_plane {
+    lane_t la[3], lb[3];
+    lane_t na[3], nb[3], t1a[3], t1b[3], t2a[3], t2b[3];
+    lane_t ka, kb;
+} wide_plane;
+
 /* A compact batch's inverse inertias in its basis e = (n, t1, t2), e_i.I^-1 e_j:
  * the upper triangle 00 01 02 11 12 22. */
 typedef struct wide_inertia {
@@ -109,7 +133,10 @@ typedef struct wide_lock {
 enum {
     WIDE_KIND_LOCKED = 1,        /* a body is locked to a plane */
     WIDE_KIND_SPINLESS = 2,      /* every body static or rotation-locked */
-    WIDE_KINDS = 4
+    /* every body static or locked to a plane, and some can turn: the three
+     * planar degrees of freedom (wide_ppoint; not a bit: it has neither of the above's rows) */
+    WIDE_KIND_PLANAR = 4,
+    WIDE_KINDS = 5
 };
 
 typedef struct wide_batch {
@@ -122,7 +149,7 @@ typedef struct wide_batch {
     int lanes;                   /* lanes in use */
     int first;                   /* first of `count` wide points */
     int lock;                    /* its manifolds' plane normals in the set's locks, or -1: no body locked */
-    int kind;                    /* WIDE_KIND_* bits */
+    int kind;                    /* WIDE_KIND_* bits, or WIDE_KIND_PLANAR (its lock indexes the set's planes) */
 } wide_batch;
 
 struct wide_set {
@@ -130,6 +157,8 @@ struct wide_set {
     wide_point *points;
     wide_cpoint *cpoints;        /* the same block, compact: one or the other is used */
     wide_lpoint *lpoints;        /* the spinless batches' points (either layout) */
+    wide_ppoint *ppoints;        /* the planar batches' points (either layout) */
+    wide_plane *planes;          /* the planar batches' bodies (wb->lock indexes them) */
     wide_inertia *inertia;       /* compact: per batch */
     int compact;                 /* the batches take the compact rows */
     wide_lock *locks;            /* locked batches' plane normals */
@@ -171,10 +200,17 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
         wb->t1[d][l] = v3_get(c->t1, d);
         wb->t2[d][l] = v3_get(c->t2, d);
     }
-    if (wb->lock >= 0) {
+    if (wb->kind == WIDE_KIND_PLANAR || wb->kind == (WIDE_KIND_SPINLESS | WIDE_KIND_LOCKED)) {
+        wide_plane *pl = &ws->planes[wb->lock];
+        vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
+        for (int d = 0; d < 3; d++) {
+            pl->la[d][l] = v3_get(la, d);
+            pl->lb[d][l] = v3_get(lb, d);
+        }
+    } else if (wb->lock >= 0) {
         wide_lock *lk = &ws->locks[wb->lock];
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
-        if (ws->compact && !(wb->kind & WIDE_KIND_SPINLESS)) { /* in the basis (spinless rows are solved in the world's) */
+        if (ws->compact) { /* in the basis */
             la = v3(v3_dot(la, c->n), v3_dot(la, c->t1), v3_dot(la, c->t2));
             lb = v3(v3_dot(lb, c->n), v3_dot(lb, c->t1), v3_dot(lb, c->t2));
         }
@@ -193,7 +229,10 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
 /* A manifold's batch kind (WIDE_KIND_*). */
 static int kind_of(const contact_constraint *c)
 {
-    return (c->locked != 0 ? WIDE_KIND_LOCKED : 0) | (c->spinless ? WIDE_KIND_SPINLESS : 0);
+    if (c->spinless) return WIDE_KIND_SPINLESS | (c->locked != 0 ? WIDE_KIND_LOCKED : 0);
+    if (!c->locked) return 0;
+    /* planar: each moving body is a locked one (c->locked has a bit for every plane-locked moving body) */
+    return (c->a == 0 || (c->locked & 1)) && (c->b == 0 || (c->locked & 2)) ? WIDE_KIND_PLANAR : WIDE_KIND_LOCKED;
 }
 
 /* Per colour, kind and point count: manifolds counted, then lanes filled,
@@ -218,12 +257,17 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc
     size_t point_size = compact ? sizeof(wide_cpoint) : sizeof(wide_point);
     int kinds = 0, turning_kinds = 0, spinless_kinds = 0, nturning = 0, nspinless = 0, nlocked = 0, locked_kinds = 0;
     for (int k = 0; k < WIDE_KINDS; k++) {
-        if (!pc->manifolds[k]) continue;
+        if (!pc->manifolds[k] || k == WIDE_KIND_PLANAR) continue;
         kinds++;
         if (k & WIDE_KIND_SPINLESS) { spinless_kinds++; nspinless += pc->points[k]; }
         else { turning_kinds++; nturning += pc->points[k]; }
-        if (k & WIDE_KIND_LOCKED) { locked_kinds++; nlocked += pc->manifolds[k]; }
+        if (k == WIDE_KIND_LOCKED) { locked_kinds++; nlocked += pc->manifolds[k]; }
     }
+    int nplanar = pc->manifolds[WIDE_KIND_PLANAR], nplanar_points = pc->points[WIDE_KIND_PLANAR];
+    int nplaned = nplanar + pc->manifolds[WIDE_KIND_SPINLESS | WIDE_KIND_LOCKED]; /* batches with planes */
+    kinds += nplanar > 0;
+    int max_planes = nplaned ? nplaned / LANES + 2 * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
+    int max_ppoints = nplanar ? nplanar_points / LANES + WIDE_COLORS * (1 + 2 + 3 + 4) + 1 : 0;
     int max_batches = ncon / LANES + kinds * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1;
     int max_locks = nlocked ? nlocked / LANES + locked_kinds * WIDE_COLORS * MANIFOLD_MAX_POINTS + 1 : 0;
     int max_wide_points = nturning / LANES + turning_kinds * WIDE_COLORS * (1 + 2 + 3 + 4) + 1;
@@ -232,6 +276,7 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc
     size_t bytes = align_up(sizeof(struct wide_set)) + align_up(sizeof(wide_batch) * (size_t)max_batches) +
                    align_up(point_size * (size_t)max_wide_points) + align_up(sizeof(wide_lpoint) * (size_t)max_lpoints) +
                    align_up(sizeof(wide_lock) * (size_t)max_locks) + inertia_bytes +
+                   align_up(sizeof(wide_ppoint) * (size_t)max_ppoints) + align_up(sizeof(wide_plane) * (size_t)max_planes) +
                    align_up(sizeof(int) * (size_t)ncon) * 2 +
                    align_up(sizeof(uint32_t) * (size_t)nb) + align_up(sizeof(double) * (size_t)max_batches);
     if (bytes > *capacity) {
@@ -253,6 +298,10 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc
     base += align_up(point_size * (size_t)max_wide_points);
     ws->lpoints = (wide_lpoint *)base;
     base += align_up(sizeof(wide_lpoint) * (size_t)max_lpoints);
+    ws->ppoints = (wide_ppoint *)base;
+    base += align_up(sizeof(wide_ppoint) * (size_t)max_ppoints);
+    ws->planes = (wide_plane *)base;
+    base += align_up(sizeof(wide_plane) * (size_t)max_planes);
     ws->inertia = compact ? (wide_inertia *)base : NULL;
     base += inertia_bytes;
     ws->locks = (wide_lock *)base;
@@ -296,18 +345,18 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
 /* Batches in colour order; inside a colour, by kind, then point count. */
 static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *pc)
 {
-    int nbatch = 0, nwide = 0, nlin = 0, nlock = 0;
+    int nbatch = 0, nwide = 0, nlin = 0, nlock = 0, nplan = 0, nplane = 0;
     for (int c = 0; c < WIDE_COLORS; c++) {
         ws->color_first[c] = nbatch;
         for (int kind = 0; kind < WIDE_KINDS; kind++) {
             ws->kind_first[c][kind] = nbatch;
             if (!pc->manifolds[kind]) continue; /* no bucket of this kind has any */
-            int spinless = (kind & WIDE_KIND_SPINLESS) != 0;
+            int spinless = (kind & WIDE_KIND_SPINLESS) != 0, planar = kind == WIDE_KIND_PLANAR;
             for (int n = 1; n <= MANIFOLD_MAX_POINTS; n++) {
                 int bk = BUCKET(c, kind, n);
                 pb->start[bk] = nbatch;
                 int batches = (pb->count[bk] + LANES - 1) / LANES;
-                int next = spinless ? nlin : nwide;
+                int next = spinless ? nlin : planar ? nplan : nwide;
                 for (int i = 0; i < batches; i++) {
                     wide_batch *wb = &ws->batches[nbatch + i];
                     int first = next + i * n;
@@ -316,6 +365,8 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *p
                         memset(wb, 0, sizeof *wb);
                         if (spinless) {
                             memset(&ws->lpoints[first], 0, sizeof(wide_lpoint) * (size_t)n);
+                        } else if (planar) {
+                            memset(&ws->ppoints[first], 0, sizeof(wide_ppoint) * (size_t)n);
                         } else if (ws->compact) {
                             memset(&ws->cpoints[first], 0, sizeof(wide_cpoint) * (size_t)n);
                             memset(&ws->inertia[nbatch + i], 0, sizeof(wide_inertia));
@@ -327,13 +378,17 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *p
                     wb->first = first;
                     wb->kind = kind;
                     wb->lock = -1;
-                    if (kind & WIDE_KIND_LOCKED) {
+                    if (kind == WIDE_KIND_LOCKED) {
                         wb->lock = nlock;
                         memset(&ws->locks[nlock++], 0, sizeof(wide_lock));
+                    } else if (planar || kind == (WIDE_KIND_SPINLESS | WIDE_KIND_LOCKED)) {
+                        wb->lock = nplane;
+                        memset(&ws->planes[nplane++], 0, sizeof(wide_plane));
                     }
                 }
                 nbatch += batches;
                 if (spinless) nlin += batches * n;
+                else if (planar) nplan += batches * n;
                 else nwide += batches * n;
                 pb->count[bk] = 0; /* now: lanes filled so far */
             }
@@ -418,6 +473,13 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
         lane_t neg_ = -DOT3(v, l);                                             \
         for (int k_ = 0; k_ < 3; k_++) (v)[k_] = (v)[k_] + neg_ * (l)[k_];     \
     } while (0)
+/* d's part in the plane with normal l: d - (d.l) l (d itself for l = 0). */
+#define IN_PLANE(out, d, l)                                                   \
+    do {                                                                      \
+        lane_t dl_ = DOT3(d, l);                                              \
+        for (int k_ = 0; k_ < 3; k_++) (out)[k_] = (d)[k_] - dl_ * (l)[k_];   \
+    } while (0)
+
 #define SET_LANES(dst, P0, P1, P2, P3, field)                                    \
     do {                                                                         \
         const double lanes_[LANES] = {(P0)->field, (P1)->field, (P2)->field, (P3)->field}; \
@@ -679,7 +741,10 @@ LANE_INLINE void scatter_l(const wide_batch *wb, impulse_body *bodies, const lan
     }
 }
 
-LANE_INLINE void warm_batch_l(const wide_batch *wb, wide_lpoint *pts, impulse_body *bodies, const wide_lock *lk,
+/* `locked` (a constant in each inlined copy): some body is locked to a
+ * plane (pl: the batch's planes), and each is pushed along the rows'
+ * directions in its plane, so its velocity stays there. */
+LANE_INLINE void warm_batch_l(const wide_batch *wb, wide_lpoint *pts, impulse_body *bodies, const wide_plane *pl,
                               const int locked, const int friction)
 {
     lane_lbodies lb;
@@ -689,13 +754,16 @@ LANE_INLINE void warm_batch_l(const wide_batch *wb, wide_lpoint *pts, impulse_bo
         lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
         p->total_normal_impulse += ni;
         for (int d = 0; d < 3; d++) {
-            lane_t P = friction ? wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2 : wb->n[d] * ni;
-            lb.va[d] -= lb.ma * P;
-            lb.vb[d] += lb.mb * P;
-        }
-        if (locked) {
-            KEEP_IN_PLANE(lb.va, lk->a);
-            KEEP_IN_PLANE(lb.vb, lk->b);
+            if (locked) {
+                lane_t Pa = friction ? pl->na[d] * ni + pl->t1a[d] * t1 + pl->t2a[d] * t2 : pl->na[d] * ni;
+                lane_t Pb = friction ? pl->nb[d] * ni + pl->t1b[d] * t1 + pl->t2b[d] * t2 : pl->nb[d] * ni;
+                lb.va[d] -= lb.ma * Pa;
+                lb.vb[d] += lb.mb * Pb;
+            } else {
+                lane_t P = friction ? wb->n[d] * ni + wb->t1[d] * t1 + wb->t2[d] * t2 : wb->n[d] * ni;
+                lb.va[d] -= lb.ma * P;
+                lb.vb[d] += lb.mb * P;
+            }
         }
     }
     scatter_l(wb, bodies, &lb);
@@ -717,7 +785,7 @@ LANE_INLINE void gather_translation(const wide_batch *wb, const step_context *ct
 }
 
 LANE_INLINE void solve_normal_rows_l(const wide_batch *wb, wide_lpoint *pts, const step_context *ctx,
-                                     lane_lbodies *lb, int use_bias, int hold_bounces, const wide_lock *lk,
+                                     lane_lbodies *lb, int use_bias, int hold_bounces, const wide_plane *pl,
                                      const int locked)
 {
     lane_t dp[3];
@@ -759,17 +827,13 @@ LANE_INLINE void solve_normal_rows_l(const wide_batch *wb, wide_lpoint *pts, con
         p->total_normal_impulse += lambda;
         lane_t la = lb->ma * lambda, lbm = lb->mb * lambda;
         for (int d = 0; d < 3; d++) {
-            lb->va[d] -= la * wb->n[d];
-            lb->vb[d] += lbm * wb->n[d];
-        }
-        if (locked) {
-            KEEP_IN_PLANE(lb->va, lk->a);
-            KEEP_IN_PLANE(lb->vb, lk->b);
+            lb->va[d] -= la * (locked ? pl->na[d] : wb->n[d]);
+            lb->vb[d] += lbm * (locked ? pl->nb[d] : wb->n[d]);
         }
     }
 }
 
-LANE_INLINE void solve_friction_rows_l(const wide_batch *wb, wide_lpoint *pts, lane_lbodies *lb, const wide_lock *lk,
+LANE_INLINE void solve_friction_rows_l(const wide_batch *wb, wide_lpoint *pts, lane_lbodies *lb, const wide_plane *pl,
                                        const int locked)
 {
     for (int i = 0; i < wb->count; i++) {
@@ -796,24 +860,25 @@ LANE_INLINE void solve_friction_rows_l(const wide_batch *wb, wide_lpoint *pts, l
         p->tangent_impulse[1] = n2;
         lane_t d1 = n1 - o1, d2 = n2 - o2;
         for (int d = 0; d < 3; d++) {
-            lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
-            lb->va[d] -= lb->ma * P;
-            lb->vb[d] += lb->mb * P;
-        }
-        if (locked) {
-            KEEP_IN_PLANE(lb->va, lk->a);
-            KEEP_IN_PLANE(lb->vb, lk->b);
+            if (locked) {
+                lb->va[d] -= lb->ma * (pl->t1a[d] * d1 + pl->t2a[d] * d2);
+                lb->vb[d] += lb->mb * (pl->t1b[d] * d1 + pl->t2b[d] * d2);
+            } else {
+                lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
+                lb->va[d] -= lb->ma * P;
+                lb->vb[d] += lb->mb * P;
+            }
         }
     }
 }
 
 LANE_INLINE void solve_batch_l(const wide_batch *wb, wide_lpoint *pts, const step_context *ctx, int use_bias,
-                               int hold_bounces, const wide_lock *lk, const int locked)
+                               int hold_bounces, const wide_plane *pl, const int locked)
 {
     lane_lbodies lb;
     gather_l(wb, ctx->bodies, &lb);
-    solve_normal_rows_l(wb, pts, ctx, &lb, use_bias, hold_bounces, lk, locked);
-    if (ctx->friction) solve_friction_rows_l(wb, pts, &lb, lk, locked);
+    solve_normal_rows_l(wb, pts, ctx, &lb, use_bias, hold_bounces, pl, locked);
+    if (ctx->friction) solve_friction_rows_l(wb, pts, &lb, pl, locked);
     scatter_l(wb, ctx->bodies, &lb);
 }
 
@@ -1040,17 +1105,23 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
 /* A spinless batch's points: each row's mass is its linear share alone
  * (the angular ones were zeros), the same at every point of a manifold. */
 LANE_INLINE double prepare_batch_l(const wide_batch *wb, wide_lpoint *pts, contact_constraint *cc,
-                                   const impulse_body *bodies, double warm, const wide_lock *lk, int friction)
+                                   const impulse_body *bodies, double warm, wide_plane *pl, int friction)
 {
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm, 0);
     lane_t lin[3];
     lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
-    if (lk) {
-        lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, lk->a) + LOCKED_INV_MASS(lm.mb, wb->n, lk->b);
-        lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t1, lk->b);
-        lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t2, lk->b);
+    if (pl) { /* some body locked to a plane: the rows' directions in each plane */
+        IN_PLANE(pl->na, wb->n, pl->la);
+        IN_PLANE(pl->nb, wb->n, pl->lb);
+        IN_PLANE(pl->t1a, wb->t1, pl->la);
+        IN_PLANE(pl->t1b, wb->t1, pl->lb);
+        IN_PLANE(pl->t2a, wb->t2, pl->la);
+        IN_PLANE(pl->t2b, wb->t2, pl->lb);
+        lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, pl->la) + LOCKED_INV_MASS(lm.mb, wb->n, pl->lb);
+        lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t1, pl->lb);
+        lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t2, pl->lb);
     }
     lane_t normal_mass = ROW_MASS(lin[0]), tangent_mass[2] = {zero, zero};
     if (friction) {
@@ -1070,6 +1141,253 @@ LANE_INLINE double prepare_batch_l(const wide_batch *wb, wide_lpoint *pts, conta
         p->tangent_mass[0] = tangent_mass[0];
         p->tangent_mass[1] = tangent_mass[1];
         p->base_separation = sep;
+        WARM_POINT(p, st, warm, friction);
+        deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
+    }
+    return deepest;
+}
+
+/* ---- the planar rows (wide_ppoint, wide_plane) ---------------------------
+ * Every body of the batch static or locked to a plane, and some can turn:
+ * a body's velocities are its linear velocity, kept in its plane by
+ * pushing it only along the rows' in-plane directions, and its spin about
+ * its plane normal, w = omega l (what project_planar keeps). Each row reads
+ * and writes those three degrees of freedom per body instead of six, with
+ * no projection after each row. */
+
+/* The lanes' linear velocities and spins about their plane normals. */
+typedef struct lane_pbodies {
+    lane_t va[3], vb[3];
+    lane_t oa, ob;               /* w.l */
+    lane_t ma, mb;
+} lane_pbodies;
+
+LANE_INLINE void gather_p(const wide_batch *wb, const wide_plane *pl, const impulse_body *bodies, lane_pbodies *lb)
+{
+    const impulse_body *A0 = &bodies[wb->a[0]], *A1 = &bodies[wb->a[1]], *A2 = &bodies[wb->a[2]], *A3 = &bodies[wb->a[3]];
+    const impulse_body *B0 = &bodies[wb->b[0]], *B1 = &bodies[wb->b[1]], *B2 = &bodies[wb->b[2]], *B3 = &bodies[wb->b[3]];
+    lane_t wa[3], wb_[3];
+    SET_LANES(lb->va[0], A0, A1, A2, A3, v.x);
+    SET_LANES(lb->va[1], A0, A1, A2, A3, v.y);
+    SET_LANES(lb->va[2], A0, A1, A2, A3, v.z);
+    SET_LANES(lb->vb[0], B0, B1, B2, B3, v.x);
+    SET_LANES(lb->vb[1], B0, B1, B2, B3, v.y);
+    SET_LANES(lb->vb[2], B0, B1, B2, B3, v.z);
+    SET_LANES(wa[0], A0, A1, A2, A3, w.x);
+    SET_LANES(wa[1], A0, A1, A2, A3, w.y);
+    SET_LANES(wa[2], A0, A1, A2, A3, w.z);
+    SET_LANES(wb_[0], B0, B1, B2, B3, w.x);
+    SET_LANES(wb_[1], B0, B1, B2, B3, w.y);
+    SET_LANES(wb_[2], B0, B1, B2, B3, w.z);
+    SET_LANES(lb->ma, A0, A1, A2, A3, inv_mass);
+    SET_LANES(lb->mb, B0, B1, B2, B3, inv_mass);
+    lb->oa = DOT3(wa, pl->la);
+    lb->ob = DOT3(wb_, pl->lb);
+}
+
+LANE_INLINE void scatter_p(const wide_batch *wb, const wide_plane *pl, impulse_body *bodies, const lane_pbodies *lb)
+{
+    lane_t wa[3], wb_[3];
+    for (int d = 0; d < 3; d++) {
+        wa[d] = pl->la[d] * lb->oa;
+        wb_[d] = pl->lb[d] * lb->ob;
+    }
+    for (int l = 0; l < LANES; l++) {
+        if (wb->a[l]) {
+            impulse_body *A = &bodies[wb->a[l]];
+            A->v = v3(lb->va[0][l], lb->va[1][l], lb->va[2][l]);
+            A->w = v3(wa[0][l], wa[1][l], wa[2][l]);
+        }
+        if (wb->b[l]) {
+            impulse_body *B = &bodies[wb->b[l]];
+            B->v = v3(lb->vb[0][l], lb->vb[1][l], lb->vb[2][l]);
+            B->w = v3(wb_[0][l], wb_[1][l], wb_[2][l]);
+        }
+    }
+}
+
+LANE_INLINE void warm_batch_p(const wide_batch *wb, const wide_plane *pl, wide_ppoint *pts, impulse_body *bodies,
+                              const int friction)
+{
+    lane_pbodies lb;
+    gather_p(wb, pl, bodies, &lb);
+    for (int i = 0; i < wb->count; i++) {
+        wide_ppoint *p = &pts[i];
+        lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
+        p->total_normal_impulse += ni;
+        if (friction) {
+            for (int d = 0; d < 3; d++) {
+                lb.va[d] -= lb.ma * (pl->na[d] * ni + pl->t1a[d] * t1 + pl->t2a[d] * t2);
+                lb.vb[d] += lb.mb * (pl->nb[d] * ni + pl->t1b[d] * t1 + pl->t2b[d] * t2);
+            }
+            lb.oa -= pl->ka * (p->ja_n * ni + p->ja_t[0] * t1 + p->ja_t[1] * t2);
+            lb.ob += pl->kb * (p->jb_n * ni + p->jb_t[0] * t1 + p->jb_t[1] * t2);
+        } else {
+            for (int d = 0; d < 3; d++) {
+                lb.va[d] -= lb.ma * (pl->na[d] * ni);
+                lb.vb[d] += lb.mb * (pl->nb[d] * ni);
+            }
+            lb.oa -= pl->ka * (p->ja_n * ni);
+            lb.ob += pl->kb * (p->jb_n * ni);
+        }
+    }
+    scatter_p(wb, pl, bodies, &lb);
+}
+
+LANE_INLINE void solve_normal_rows_p(const wide_batch *wb, const wide_plane *pl, wide_ppoint *pts,
+                                     const step_context *ctx, lane_pbodies *lb, int use_bias, int hold_bounces)
+{
+    lane_t dp[3], dqa[3], dqb[3];
+    gather_motion(wb, ctx, dp, dqa, dqb);
+    /* each body's rotation since the sub-steps began is about its plane normal */
+    lane_t qa = DOT3(dqa, pl->la), qb = DOT3(dqb, pl->lb), dpn = DOT3(wb->n, dp);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), inv_h = SPLAT(ctx->inv_h), push = SPLAT(-ctx->push_max);
+    lane_t pen_mass_scale = one, pen_impulse_scale = zero;
+    int soft = use_bias && ctx->correction == CAROM_CORRECTION_SOFT;
+    int baumgarte = use_bias && ctx->correction == CAROM_CORRECTION_BAUMGARTE;
+    if (soft) {
+        pen_mass_scale = wb->mass_scale;
+        pen_impulse_scale = wb->impulse_scale;
+    }
+    const lane_t baum_rate = SPLAT(ctx->baumgarte_rate), slop = SPLAT(ctx->slop);
+    for (int i = 0; i < wb->count; i++) {
+        wide_ppoint *p = &pts[i];
+        lane_t s = p->base_separation + dpn + qb * p->jb_n - qa * p->ja_n;
+        lane_t pen_bias = zero;
+        if (soft || baumgarte) {
+            lane_t rate = wb->bias_rate;
+            pen_bias = CONTACT_PUSH_BIAS(soft, s, rate, baum_rate, slop, push, zero, LANE_MAX, LANE_MIN);
+        }
+        lane_mask ahead = s > zero;
+        lane_t spec = CONTACT_SPECULATIVE_BIAS(s, inv_h);
+        lane_t bias = SELECT_LANES(ahead, spec, pen_bias);
+        lane_t mass_scale = SELECT_LANES(ahead, one, pen_mass_scale);
+        lane_t impulse_scale = SELECT_LANES(ahead, zero, pen_impulse_scale);
+        lane_t vn = wb->n[0] * (lb->vb[0] - lb->va[0]) + wb->n[1] * (lb->vb[1] - lb->va[1]) +
+                    wb->n[2] * (lb->vb[2] - lb->va[2]) + lb->ob * p->jb_n - lb->oa * p->ja_n;
+        lane_t old = p->normal_impulse;
+        lane_t total = old - p->normal_mass * mass_scale * (vn + bias) - impulse_scale * old;
+        total = LANE_MAX(total, zero);
+        if (hold_bounces) {
+            lane_mask hold = ahead & (wb->restitution > zero);
+            total = SELECT_LANES(hold, LANE_MIN(total, old), total);
+        }
+        lane_t lambda = total - old;
+        p->normal_impulse = total;
+        p->total_normal_impulse += lambda;
+        lane_t la = lb->ma * lambda, lbm = lb->mb * lambda;
+        for (int d = 0; d < 3; d++) {
+            lb->va[d] -= la * pl->na[d];
+            lb->vb[d] += lbm * pl->nb[d];
+        }
+        lb->oa -= pl->ka * (p->ja_n * lambda);
+        lb->ob += pl->kb * (p->jb_n * lambda);
+    }
+}
+
+LANE_INLINE void solve_friction_rows_p(const wide_batch *wb, const wide_plane *pl, wide_ppoint *pts, lane_pbodies *lb)
+{
+    for (int i = 0; i < wb->count; i++) {
+        wide_ppoint *p = &pts[i];
+        lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
+        lane_t v1 = DOT3(dv, wb->t1) + lb->ob * p->jb_t[0] - lb->oa * p->ja_t[0];
+        lane_t v2 = DOT3(dv, wb->t2) + lb->ob * p->jb_t[1] - lb->oa * p->ja_t[1];
+        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
+        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
+        lane_t limit = wb->friction * p->normal_impulse;
+        lane_t mag2 = n1 * n1 + n2 * n2;
+        lane_mask over = mag2 > limit * limit;
+        if (over[0] | over[1] | over[2] | over[3]) {
+            for (int l = 0; l < LANES; l++) {
+                if (!over[l]) continue;
+                double s1 = n1[l], s2 = n2[l];
+                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
+                                  limit[l]);
+                n1[l] = s1;
+                n2[l] = s2;
+            }
+        }
+        p->tangent_impulse[0] = n1;
+        p->tangent_impulse[1] = n2;
+        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        for (int d = 0; d < 3; d++) {
+            lb->va[d] -= lb->ma * (pl->t1a[d] * d1 + pl->t2a[d] * d2);
+            lb->vb[d] += lb->mb * (pl->t1b[d] * d1 + pl->t2b[d] * d2);
+        }
+        lb->oa -= pl->ka * (p->ja_t[0] * d1 + p->ja_t[1] * d2);
+        lb->ob += pl->kb * (p->jb_t[0] * d1 + p->jb_t[1] * d2);
+    }
+}
+
+LANE_INLINE void solve_batch_p(const wide_batch *wb, const wide_plane *pl, wide_ppoint *pts, const step_context *ctx,
+                               int use_bias, int hold_bounces)
+{
+    lane_pbodies lb;
+    gather_p(wb, pl, ctx->bodies, &lb);
+    solve_normal_rows_p(wb, pl, pts, ctx, &lb, use_bias, hold_bounces);
+    if (ctx->friction) solve_friction_rows_p(wb, pl, pts, &lb);
+    scatter_p(wb, pl, ctx->bodies, &lb);
+}
+
+/* A planar batch's points: the rows' directions in each body's plane and
+ * the moments about the normals (k = l.(I^-1 l) for I^-1 = k l l^T; 0 for
+ * the static body), then per point the arms' components about the normals
+ * and the masses 1 / (1/mA (1 - (d.lA)^2) + kA ((rA x d).lA)^2 + ...). */
+LANE_INLINE double prepare_batch_p(const wide_batch *wb, wide_plane *pl, wide_ppoint *pts, contact_constraint *cc,
+                                   const impulse_body *bodies, double warm, int friction)
+{
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
+    lane_manifolds lm;
+    gather_manifolds(wb, cc, bodies, &lm, 1);
+    IN_PLANE(pl->na, wb->n, pl->la);
+    IN_PLANE(pl->nb, wb->n, pl->lb);
+    IN_PLANE(pl->t1a, wb->t1, pl->la);
+    IN_PLANE(pl->t1b, wb->t1, pl->lb);
+    IN_PLANE(pl->t2a, wb->t2, pl->la);
+    IN_PLANE(pl->t2b, wb->t2, pl->lb);
+    lane_t ila[3], ilb[3];
+    MAT_VEC(ila, lm.ia, pl->la);
+    MAT_VEC(ilb, lm.ib, pl->lb);
+    pl->ka = DOT3(pl->la, ila);
+    pl->kb = DOT3(pl->lb, ilb);
+    lane_t lin[3];
+    lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, pl->la) + LOCKED_INV_MASS(lm.mb, wb->n, pl->lb);
+    lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t1, pl->lb);
+    lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t2, pl->lb);
+    double deepest = 0.0;
+    for (int i = 0; i < wb->count; i++) {
+        wide_ppoint *p = &pts[i];
+        const contact_point_state *st[LANES];
+        lane_t ra[3], rb[3], sep;
+        gather_point(&lm, i, st, ra, rb, &sep);
+        lane_t xa[3], xb[3];
+        CROSS(xa, ra, wb->n);
+        CROSS(xb, rb, wb->n);
+        p->ja_n = DOT3(xa, pl->la);
+        p->jb_n = DOT3(xb, pl->lb);
+        lane_t kn = lin[0] + pl->ka * p->ja_n * p->ja_n + pl->kb * p->jb_n * p->jb_n;
+        p->normal_mass = ROW_MASS(kn);
+        if (friction) {
+            CROSS(xa, ra, wb->t1);
+            CROSS(xb, rb, wb->t1);
+            p->ja_t[0] = DOT3(xa, pl->la);
+            p->jb_t[0] = DOT3(xb, pl->lb);
+            CROSS(xa, ra, wb->t2);
+            CROSS(xb, rb, wb->t2);
+            p->ja_t[1] = DOT3(xa, pl->la);
+            p->jb_t[1] = DOT3(xb, pl->lb);
+            lane_t k1 = lin[1] + pl->ka * p->ja_t[0] * p->ja_t[0] + pl->kb * p->jb_t[0] * p->jb_t[0];
+            lane_t k2 = lin[2] + pl->ka * p->ja_t[1] * p->ja_t[1] + pl->kb * p->jb_t[1] * p->jb_t[1];
+            p->tangent_mass[0] = ROW_MASS(k1);
+            p->tangent_mass[1] = ROW_MASS(k2);
+        }
+        p->base_separation = sep;
+        lane_t wxa[3], wxb[3];
+        CROSS(wxa, lm.wa, ra);
+        CROSS(wxb, lm.wb, rb);
+        lane_t vrel[3];
+        for (int d = 0; d < 3; d++) vrel[d] = (lm.vb[d] + wxb[d]) - (lm.va[d] + wxa[d]);
+        lane_t vn = DOT3(vrel, wb->n);
         WARM_POINT(p, st, warm, friction);
         deepest = store_point(wb, &lm, i, ra, rb, &sep, &vn, deepest);
     }
@@ -1378,9 +1696,13 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
+            const wide_lock *lk = wb->kind == WIDE_KIND_LOCKED ? &ws->locks[wb->lock] : NULL;          \
             if (wb->kind & WIDE_KIND_SPINLESS)                                                           \
-                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm, lk, friction); \
+                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm,          \
+                                                 wb->lock >= 0 ? &ws->planes[wb->lock] : NULL, friction); \
+            else if (wb->kind == WIDE_KIND_PLANAR)                                                       \
+                ws->deepest[k] = prepare_batch_p(wb, &ws->planes[wb->lock], &ws->ppoints[wb->first], cc, bodies, \
+                                                 warm, friction);                                        \
             else                                                                                         \
                 ws->deepest[k] = prepare_batch(wb, &ws->points[wb->first], cc, bodies, warm, lk, friction); \
         }                                                                                                \
@@ -1420,8 +1742,26 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            if (friction) warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 1);\
-            else warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->locks[wb->lock], 1, 0);      \
+            if (friction) warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->planes[wb->lock], 1, 1); \
+            else warm_batch_l(wb, &ws->lpoints[wb->first], bodies, &ws->planes[wb->lock], 1, 0);     \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void warm_planar##SUFFIX(const wide_set *ws, impulse_body *bodies, \
+                                                                    int friction, int first, int last)   \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            if (friction) warm_batch_p(wb, &ws->planes[wb->lock], &ws->ppoints[wb->first], bodies, 1);   \
+            else warm_batch_p(wb, &ws->planes[wb->lock], &ws->ppoints[wb->first], bodies, 0);            \
+        }                                                                                                \
+    }                                                                                                    \
+    TARGET __attribute__((noinline)) static void solve_planar##SUFFIX(const wide_set *ws, const step_context *ctx, \
+                                                                     int use_bias, int hold_bounces, int first, \
+                                                                     int last)                           \
+    {                                                                                                    \
+        for (int k = first; k < last; k++) {                                                             \
+            const wide_batch *wb = &ws->batches[k];                                                      \
+            solve_batch_p(wb, &ws->planes[wb->lock], &ws->ppoints[wb->first], ctx, use_bias, hold_bounces); \
         }                                                                                                \
     }                                                                                                    \
     TARGET __attribute__((noinline)) static void solve_locked##SUFFIX(const wide_set *ws, const step_context *ctx, \
@@ -1458,7 +1798,7 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            solve_batch_l(wb, &ws->lpoints[wb->first], ctx, use_bias, hold_bounces, &ws->locks[wb->lock], 1); \
+            solve_batch_l(wb, &ws->lpoints[wb->first], ctx, use_bias, hold_bounces, &ws->planes[wb->lock], 1); \
         }                                                                                                \
     }                                                                                                    \
     TARGET static void prepare_batches_c##SUFFIX(const wide_set *ws, contact_constraint *cc,             \
@@ -1467,9 +1807,13 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
-            const wide_lock *lk = wb->lock >= 0 ? &ws->locks[wb->lock] : NULL;                          \
+            const wide_lock *lk = wb->kind == WIDE_KIND_LOCKED ? &ws->locks[wb->lock] : NULL;          \
             if (wb->kind & WIDE_KIND_SPINLESS)                                                           \
-                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm, lk, friction); \
+                ws->deepest[k] = prepare_batch_l(wb, &ws->lpoints[wb->first], cc, bodies, warm,          \
+                                                 wb->lock >= 0 ? &ws->planes[wb->lock] : NULL, friction); \
+            else if (wb->kind == WIDE_KIND_PLANAR)                                                       \
+                ws->deepest[k] = prepare_batch_p(wb, &ws->planes[wb->lock], &ws->ppoints[wb->first], cc, bodies, \
+                                                 warm, friction);                                        \
             else                                                                                         \
                 ws->deepest[k] = prepare_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], cc, bodies, warm, \
                                                  lk, friction);                                          \
@@ -1511,14 +1855,18 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
             solve_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], ctx, use_bias, hold_bounces, NULL, 0); \
         }                                                                                                \
     }                                                                                                    \
-    /* indexed by kind: free, locked, spinless, spinless and locked (both layouts share the spinless rows) */ \
+    /* indexed by kind: free, locked, spinless, spinless and locked, planar (both layouts share the spinless and planar rows) */ \
     static const wide_kernels passes##SUFFIX = {                                                         \
         {prepare_batches##SUFFIX,                                                                        \
-         {warm_batches##SUFFIX, warm_locked##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX}, \
-         {solve_batches##SUFFIX, solve_locked##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX}}, \
+         {warm_batches##SUFFIX, warm_locked##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX,    \
+          warm_planar##SUFFIX},                                                                          \
+         {solve_batches##SUFFIX, solve_locked##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX, \
+          solve_planar##SUFFIX}},                                                                        \
         {prepare_batches_c##SUFFIX,                                                                      \
-         {warm_batches_c##SUFFIX, warm_locked_c##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX}, \
-         {solve_batches_c##SUFFIX, solve_locked_c##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX}}};
+         {warm_batches_c##SUFFIX, warm_locked_c##SUFFIX, warm_spinless##SUFFIX, warm_spinless_locked##SUFFIX, \
+          warm_planar##SUFFIX},                                                                          \
+         {solve_batches_c##SUFFIX, solve_locked_c##SUFFIX, solve_spinless##SUFFIX, solve_spinless_locked##SUFFIX, \
+          solve_planar##SUFFIX}}};
 
 WIDE_PASSES(_base, )
 #if WIDE_AVX2
@@ -1658,6 +2006,9 @@ void wide_read_impulses(const wide_set *ws, contact_constraint *c)
     if (wb->kind & WIDE_KIND_SPINLESS) {
         const wide_lpoint *wide_lpoint_array = ws->lpoints;
         READ_IMPULSES(wide_lpoint)
+    } else if (wb->kind == WIDE_KIND_PLANAR) {
+        const wide_ppoint *wide_ppoint_array = ws->ppoints;
+        READ_IMPULSES(wide_ppoint)
     } else if (ws->compact) {
         const wide_cpoint *wide_cpoint_array = ws->cpoints;
         READ_IMPULSES(wide_cpoint)
@@ -1686,10 +2037,13 @@ void wide_store(const wide_set *ws, contact_constraint *cc)
     const wide_point *wide_point_array = ws->points;
     const wide_cpoint *wide_cpoint_array = ws->cpoints;
     const wide_lpoint *wide_lpoint_array = ws->lpoints;
+    const wide_ppoint *wide_ppoint_array = ws->ppoints;
     for (int k = 0; k < ws->batch_count; k++) {
         const wide_batch *wb = &ws->batches[k];
         if (wb->kind & WIDE_KIND_SPINLESS) {
             STORE_POINTS(wide_lpoint)
+        } else if (wb->kind == WIDE_KIND_PLANAR) {
+            STORE_POINTS(wide_ppoint)
         } else if (ws->compact) {
             STORE_POINTS(wide_cpoint)
         } else {
