@@ -373,11 +373,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
     c->locked = !w->scratch.solver.planar ? 0 :
                 (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
                 (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
-    /* neither body can turn (the static body 0, or rotation-locked: zero
-     * inverse inertia, w and dq stay zero): the wide passes drop the
-     * angular terms, which would only multiply zeros */
-    c->spinless = w->scratch.solver.rotation_locked && (c->a == 0 || (bs->flags[sa] & BODY_LOCK_ROTATION)) &&
-                  (c->b == 0 || (bs->flags[sb] & BODY_LOCK_ROTATION));
+    c->spinless = 0; /* mark_spinless, where some body is rotation-locked */
     c->an = NULL;
     c->r = NULL;
     c->spring = NULL;
@@ -409,6 +405,65 @@ typedef struct constraint_job {
     solver_work *work;
 } constraint_job;
 
+/* What fill_constraint reads, fetched ahead in stages (the manifolds come
+ * bottom-up, not in the contact set's or the bodies' order, so each of its
+ * reads is a cache miss of its own, and one constraint's work is too long
+ * for the processor to reach the next one's loads by itself): the contact
+ * and its data PREFETCH_FAR constraints ahead, the bodies' id entries half
+ * way, their slots' fields and solver bodies PREFETCH_NEAR ahead, each
+ * stage reading only what an earlier one brought in. Hints only: no
+ * result depends on them. */
+#define PREFETCH_FAR 16
+#define PREFETCH_MID 8
+#define PREFETCH_NEAR 4
+#if defined(__GNUC__)
+#define PREFETCH(p) __builtin_prefetch(p)
+/* inlined: GCC drops the prefetches of a helper it keeps out of line (a call with no effect) */
+#define PREFETCH_INLINE static inline __attribute__((always_inline))
+#else
+#define PREFETCH(p) ((void)(p))
+#define PREFETCH_INLINE static inline
+#endif
+PREFETCH_INLINE void prefetch_constraint_inputs(const carom_world *w, const step_context *ctx, const int *touching, int k,
+                                                int end)
+{
+    const contact_set *cs = &w->contacts;
+    const body_store *bs = &w->bodies;
+    if (k + PREFETCH_FAR < end) {
+        int i = touching[k + PREFETCH_FAR];
+        PREFETCH(&cs->items[i]);
+    }
+    if (k + PREFETCH_MID < end) {
+        const contact *ct = &cs->items[touching[k + PREFETCH_MID]];
+        const char *cd = (const char *)&cs->data[ct->slot];
+        for (size_t o = 0; o < sizeof(contact_data); o += 64) PREFETCH(cd + o);
+        PREFETCH(&bs->ids[ct->id_a]);
+        PREFETCH(&bs->ids[ct->id_b]);
+    }
+    if (k + PREFETCH_NEAR < end) {
+        const contact *ct = &cs->items[touching[k + PREFETCH_NEAR]];
+        int sa = bs->ids[ct->id_a].slot, sb = bs->ids[ct->id_b].slot;
+        PREFETCH(&bs->solver_index[sa]);
+        PREFETCH(&bs->solver_index[sb]);
+        PREFETCH(&bs->center[sa]);
+        PREFETCH(&bs->center[sb]);
+    }
+    if (k + 2 < end) {
+        const contact *ct = &cs->items[touching[k + 2]];
+        int a = bs->solver_index[bs->ids[ct->id_a].slot], b = bs->solver_index[bs->ids[ct->id_b].slot];
+        const body_step *motion = w->scratch.solver.motion;
+        PREFETCH(&ctx->bodies[a]);
+        PREFETCH(&ctx->bodies[b]);
+        PREFETCH(&motion[a]);
+        PREFETCH(&motion[b]);
+    }
+}
+
+/* From this many constraints on, their inputs are fetched ahead: below it
+ * they stay in the caches between steps (the canonical scenes), and the
+ * prefetches would be instructions for nothing. */
+#define PREFETCH_MIN_CONSTRAINTS 8192
+
 /* Each constraint from its own manifold (its points already placed). */
 static void fill_constraints_range(int begin, int end, int worker, void *p)
 {
@@ -417,7 +472,12 @@ static void fill_constraints_range(int begin, int end, int worker, void *p)
     load_softness ls;
     load_softness_init(&ls, j->ctx);
     (void)worker;
-    for (int k = begin; k < end; k++) fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
+    /* one loop, one call: fill_constraint stays inlined as it was */
+    int prefetch = j->w->scratch.touching_count >= PREFETCH_MIN_CONSTRAINTS;
+    for (int k = begin; k < end; k++) {
+        if (prefetch) prefetch_constraint_inputs(j->w, j->ctx, touching, k, end);
+        fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
+    }
 }
 
 /* The solver block's bytes (build_constraints): ncon constraints (their
@@ -630,6 +690,20 @@ static int sort_touching(carom_world *w, const step_context *ctx)
     return 1;
 }
 
+/* Manifolds where neither body can turn (the static body 0, or
+ * rotation-locked: zero inverse inertia, and w and dq stay zero): the wide
+ * passes drop their angular terms, which would only multiply zeros. Only
+ * where some awake body is rotation-locked (solver_memory.rotation_locked). */
+static void mark_spinless(const carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon)
+{
+    const uint32_t *flags = w->bodies.flags;
+    for (int k = 0; k < ncon; k++) {
+        contact_constraint *c = &cc[k];
+        c->spinless = (c->a == 0 || (flags[ctx->body_slot[c->a]] & BODY_LOCK_ROTATION)) &&
+                      (c->b == 0 || (flags[ctx->body_slot[c->b]] & BODY_LOCK_ROTATION));
+    }
+}
+
 /* The few manifolds with a plane-locked body or rolling resistance get
  * their extra fields (constraint_extra), in constraint order. */
 static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon, int *locked)
@@ -672,6 +746,7 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     work->in_contact = work->level_count + nb + 3;
     constraint_job job = {w, ctx, cc, NULL};
     tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
+    if (s->solver.rotation_locked) mark_spinless(w, ctx, cc, ncon);
     if (!attach_extras(w, ctx, cc, ncon, &work->locked)) return 0;
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
     for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;

@@ -169,6 +169,7 @@ struct wide_set {
     /* colour c's batches of kind k: kind_first[c][k] .. the next kind's first - 1 (the last kind's: color_first[c + 1] - 1) */
     int kind_first[WIDE_COLORS][WIDE_KINDS];
     int avx2;                    /* run the AVX2 build of the passes */
+    int free_only;               /* every batch is of the free kind (the passes skip the kinds' spans) */
 };
 
 /* One build of the passes over the batches first .. last - 1 (WIDE_PASSES). */
@@ -200,14 +201,16 @@ static void fill_header(const wide_set *ws, wide_batch *wb, int l, int ci, const
         wb->t1[d][l] = v3_get(c->t1, d);
         wb->t2[d][l] = v3_get(c->t2, d);
     }
-    if (wb->kind == WIDE_KIND_PLANAR || wb->kind == (WIDE_KIND_SPINLESS | WIDE_KIND_LOCKED)) {
+    if (wb->lock < 0) {
+        /* no body locked to a plane */
+    } else if (wb->kind == WIDE_KIND_PLANAR || wb->kind == (WIDE_KIND_SPINLESS | WIDE_KIND_LOCKED)) {
         wide_plane *pl = &ws->planes[wb->lock];
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
         for (int d = 0; d < 3; d++) {
             pl->la[d][l] = v3_get(la, d);
             pl->lb[d][l] = v3_get(lb, d);
         }
-    } else if (wb->lock >= 0) {
+    } else {
         wide_lock *lk = &ws->locks[wb->lock];
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
         if (ws->compact) { /* in the basis */
@@ -446,6 +449,8 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
     plan_buckets pb;
     color_manifolds(ws, cc, ncon, kinds, color, used, &pb);
     lay_out_batches(ws, &pb, &pc);
+    ws->free_only = 1;
+    for (int kind = 1; kind < WIDE_KINDS; kind++) ws->free_only &= pc.manifolds[kind] == 0;
     fill_lanes(ws, cc, ncon, color, &pb);
 #if WIDE_AVX2
     /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
@@ -1685,6 +1690,28 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     return deepest;
 }
 
+/* A large world's batches (the compact rows) reach their bodies in no
+ * order the caches can follow: a pass fetches the bodies of the batch
+ * WIDE_PREFETCH ahead (and, solving, their motion since the step began)
+ * while it solves this one. Hints only: no result depends on them. */
+#define WIDE_PREFETCH 4
+LANE_INLINE void prefetch_batch(const wide_set *ws, const impulse_body *bodies, const step_context *ctx, int k,
+                                int last)
+{
+    if (k + WIDE_PREFETCH >= last) return;
+    const wide_batch *wb = &ws->batches[k + WIDE_PREFETCH];
+    for (int l = 0; l < LANES; l++) {
+        __builtin_prefetch(&bodies[wb->a[l]]);
+        __builtin_prefetch(&bodies[wb->b[l]]);
+        if (ctx) {
+            __builtin_prefetch(&ctx->dp[wb->a[l]]);
+            __builtin_prefetch(&ctx->dp[wb->b[l]]);
+            __builtin_prefetch(&ctx->dq[wb->a[l]]);
+            __builtin_prefetch(&ctx->dq[wb->b[l]]);
+        }
+    }
+}
+
 /* The passes over every batch, written once and built twice: for the base
  * target (SSE2 on x86-64) and, chosen at run time, for AVX2 (one register per
  * four lanes instead of two, and twice the registers). No FMA: rounding stays
@@ -1833,6 +1860,7 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
+            prefetch_batch(ws, bodies, NULL, k, last);                                                   \
             if (friction) warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0, 1);\
             else warm_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], bodies, NULL, 0, 0);     \
         }                                                                                                \
@@ -1852,6 +1880,7 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     {                                                                                                    \
         for (int k = first; k < last; k++) {                                                             \
             const wide_batch *wb = &ws->batches[k];                                                      \
+            prefetch_batch(ws, ctx->bodies, ctx, k, last);                                               \
             solve_batch_c(wb, &ws->inertia[k], &ws->cpoints[wb->first], ctx, use_bias, hold_bounces, NULL, 0); \
         }                                                                                                \
     }                                                                                                    \
@@ -1923,6 +1952,10 @@ static void warm_range(int begin, int end, int worker, void *p)
     const wide_job *j = p;
     (void)worker;
     int first = j->offset + begin, last = j->offset + end, from, to;
+    if (j->ws->free_only) {
+        j->passes->warm[0](j->ws, j->ctx->bodies, j->ctx->friction, first, last);
+        return;
+    }
     for (int k = 0; k < WIDE_KINDS; k++)
         if (kind_span(j, k, first, last, &from, &to)) j->passes->warm[k](j->ws, j->ctx->bodies, j->ctx->friction, from, to);
 }
@@ -1932,6 +1965,10 @@ static void solve_range(int begin, int end, int worker, void *p)
     const wide_job *j = p;
     (void)worker;
     int first = j->offset + begin, last = j->offset + end, from, to;
+    if (j->ws->free_only) {
+        j->passes->solve[0](j->ws, j->ctx, j->use_bias, j->hold_bounces, first, last);
+        return;
+    }
     for (int k = 0; k < WIDE_KINDS; k++)
         if (kind_span(j, k, first, last, &from, &to))
             j->passes->solve[k](j->ws, j->ctx, j->use_bias, j->hold_bounces, from, to);
