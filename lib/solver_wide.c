@@ -658,6 +658,35 @@ LANE_INLINE void solve_normal_rows(const wide_batch *wb, wide_point *pts, const 
     }
 }
 
+/* One point's two friction rows in every lane: the accumulated impulses take
+ * the unclamped step, then lanes outside Coulomb's cone (|t| <= mu * normal)
+ * are brought back by coulomb_over_cone; *d1, *d2 are the impulses applied.
+ * Every kernel kind (full, spinless, planar, compact) shares it. */
+LANE_INLINE void friction_lanes(lane_t impulse[2], const lane_t mass[2], const lane_t *normal_impulse,
+                                const lane_t *friction, const lane_t *vel1, const lane_t *vel2, lane_t *d1, lane_t *d2)
+{
+    /* vectors by pointer: by value they would change the ABI between the SSE2 and AVX2 builds */
+    lane_t v1 = *vel1, v2 = *vel2;
+    lane_t o1 = impulse[0], o2 = impulse[1];
+    lane_t n1 = o1 - mass[0] * v1, n2 = o2 - mass[1] * v2;
+    lane_t limit = *friction * *normal_impulse;
+    lane_t mag2 = n1 * n1 + n2 * n2;
+    lane_mask over = mag2 > limit * limit;
+    if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
+        for (int l = 0; l < LANES; l++) {
+            if (!over[l]) continue;
+            double s1 = n1[l], s2 = n2[l];
+            coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], mass[0][l], mass[1][l], limit[l]);
+            n1[l] = s1;
+            n2[l] = s2;
+        }
+    }
+    impulse[0] = n1;
+    impulse[1] = n2;
+    *d1 = n1 - o1;
+    *d2 = n2 - o2;
+}
+
 /* The friction rows of every point of a batch (contact_solve's second loop). */
 LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane_bodies *lb, const wide_lock *lk,
                                      const int locked)
@@ -667,25 +696,8 @@ LANE_INLINE void solve_friction_rows(const wide_batch *wb, wide_point *pts, lane
         lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
         lane_t v1 = DOT3(dv, wb->t1) + DOT3(lb->wb, p->rb_t[0]) - DOT3(lb->wa, p->ra_t[0]);
         lane_t v2 = DOT3(dv, wb->t2) + DOT3(lb->wb, p->rb_t[1]) - DOT3(lb->wa, p->ra_t[1]);
-        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-        /* Coulomb's cone (coulomb_factor): scale back to |t| <= mu * normal */
-        lane_t limit = wb->friction * p->normal_impulse;
-        lane_t mag2 = n1 * n1 + n2 * n2;
-        lane_mask over = mag2 > limit * limit;
-        if (over[0] | over[1] | over[2] | over[3]) { /* resting contacts are inside the cone */
-            for (int l = 0; l < LANES; l++) {
-                if (!over[l]) continue;
-                double s1 = n1[l], s2 = n2[l];
-                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
-                                  limit[l]);
-                n1[l] = s1;
-                n2[l] = s2;
-            }
-        }
-        p->tangent_impulse[0] = n1;
-        p->tangent_impulse[1] = n2;
-        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        lane_t d1, d2;
+        friction_lanes(p->tangent_impulse, p->tangent_mass, &p->normal_impulse, &wb->friction, &v1, &v2, &d1, &d2);
         for (int d = 0; d < 3; d++) {
             lane_t P = wb->t1[d] * d1 + wb->t2[d] * d2;
             lb->va[d] -= lb->ma * P;
@@ -846,24 +858,8 @@ LANE_INLINE void solve_friction_rows_l(const wide_batch *wb, wide_lpoint *pts, l
         lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
         lane_t v1 = DOT3(dv, wb->t1);
         lane_t v2 = DOT3(dv, wb->t2);
-        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-        lane_t limit = wb->friction * p->normal_impulse;
-        lane_t mag2 = n1 * n1 + n2 * n2;
-        lane_mask over = mag2 > limit * limit;
-        if (over[0] | over[1] | over[2] | over[3]) {
-            for (int l = 0; l < LANES; l++) {
-                if (!over[l]) continue;
-                double s1 = n1[l], s2 = n2[l];
-                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
-                                  limit[l]);
-                n1[l] = s1;
-                n2[l] = s2;
-            }
-        }
-        p->tangent_impulse[0] = n1;
-        p->tangent_impulse[1] = n2;
-        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        lane_t d1, d2;
+        friction_lanes(p->tangent_impulse, p->tangent_mass, &p->normal_impulse, &wb->friction, &v1, &v2, &d1, &d2);
         for (int d = 0; d < 3; d++) {
             if (locked) {
                 lb->va[d] -= lb->ma * (pl->t1a[d] * d1 + pl->t2a[d] * d2);
@@ -1297,24 +1293,8 @@ LANE_INLINE void solve_friction_rows_p(const wide_batch *wb, const wide_plane *p
         lane_t dv[3] = {lb->vb[0] - lb->va[0], lb->vb[1] - lb->va[1], lb->vb[2] - lb->va[2]};
         lane_t v1 = DOT3(dv, wb->t1) + lb->ob * p->jb_t[0] - lb->oa * p->ja_t[0];
         lane_t v2 = DOT3(dv, wb->t2) + lb->ob * p->jb_t[1] - lb->oa * p->ja_t[1];
-        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-        lane_t limit = wb->friction * p->normal_impulse;
-        lane_t mag2 = n1 * n1 + n2 * n2;
-        lane_mask over = mag2 > limit * limit;
-        if (over[0] | over[1] | over[2] | over[3]) {
-            for (int l = 0; l < LANES; l++) {
-                if (!over[l]) continue;
-                double s1 = n1[l], s2 = n2[l];
-                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
-                                  limit[l]);
-                n1[l] = s1;
-                n2[l] = s2;
-            }
-        }
-        p->tangent_impulse[0] = n1;
-        p->tangent_impulse[1] = n2;
-        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        lane_t d1, d2;
+        friction_lanes(p->tangent_impulse, p->tangent_mass, &p->normal_impulse, &wb->friction, &v1, &v2, &d1, &d2);
         for (int d = 0; d < 3; d++) {
             lb->va[d] -= lb->ma * (pl->t1a[d] * d1 + pl->t2a[d] * d2);
             lb->vb[d] += lb->mb * (pl->t1b[d] * d1 + pl->t2b[d] * d2);
@@ -1569,24 +1549,8 @@ LANE_INLINE void solve_friction_rows_c(const wide_batch *wb, const wide_inertia 
                     (a[0] * lb->wa[2] - a[2] * lb->wa[0]);
         lane_t v2 = (lb->vb[2] - lb->va[2]) + (b[1] * lb->wb[0] - b[0] * lb->wb[1]) -
                     (a[1] * lb->wa[0] - a[0] * lb->wa[1]);
-        lane_t o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];
-        lane_t n1 = o1 - p->tangent_mass[0] * v1, n2 = o2 - p->tangent_mass[1] * v2;
-        lane_t limit = wb->friction * p->normal_impulse;
-        lane_t mag2 = n1 * n1 + n2 * n2;
-        lane_mask over = mag2 > limit * limit;
-        if (over[0] | over[1] | over[2] | over[3]) {
-            for (int l = 0; l < LANES; l++) {
-                if (!over[l]) continue;
-                double s1 = n1[l], s2 = n2[l];
-                coulomb_over_cone(&s1, &s2, o1[l], o2[l], v1[l], v2[l], p->tangent_mass[0][l], p->tangent_mass[1][l],
-                                  limit[l]);
-                n1[l] = s1;
-                n2[l] = s2;
-            }
-        }
-        p->tangent_impulse[0] = n1;
-        p->tangent_impulse[1] = n2;
-        lane_t d1 = n1 - o1, d2 = n2 - o2;
+        lane_t d1, d2;
+        friction_lanes(p->tangent_impulse, p->tangent_mass, &p->normal_impulse, &wb->friction, &v1, &v2, &d1, &d2);
         lb->va[1] -= lb->ma * d1;
         lb->va[2] -= lb->ma * d2;
         lb->vb[1] += lb->mb * d1;
