@@ -415,19 +415,107 @@ static int build_subtree(broadphase *bp, int *ids, double *key, int lo, int hi)
     return parent;
 }
 
+/* A 10-bit cell number spread to every third bit: three of them
+ * interleaved (x lowest) are a centre's Z-order (Morton) code. */
+static uint32_t spread10(uint32_t v)
+{
+    v &= 0x3ffu;
+    v = (v | v << 16) & 0x030000ffu;
+    v = (v | v << 8) & 0x0300f00fu;
+    v = (v | v << 4) & 0x030c30c3u;
+    v = (v | v << 2) & 0x09249249u;
+    return v;
+}
+
+static uint32_t cell10(double c, double lo, double scale)
+{
+    double q = (c - lo) * scale; /* in [0, 1024) but for rounding */
+    return q >= 1023.0 ? 1023u : q > 0.0 ? (uint32_t)q : 0u;
+}
+
+/* A subtree over ids[lo..hi), sorted by their codes: split where the
+ * highest bit in which the range's codes differ turns on (one binary
+ * search: the bits above it are common to the range), i.e. along the
+ * octree's planes (depth at most 30 so); a range whose codes are all equal
+ * (centres in one cell, 1/1024th of the widest extent of the centres: a far
+ * body stretches it) falls back to median splits. */
+static int morton_subtree(broadphase *bp, int *ids, const uint32_t *code, double *key, int lo, int hi)
+{
+    if (hi - lo == 1) return ids[lo];
+    uint32_t diff = code[lo] ^ code[hi - 1];
+    if (!diff) return build_subtree(bp, ids, key, lo, hi);
+    uint32_t bit = 1u << 31;
+    while (!(diff & bit)) bit >>= 1;
+    int a0 = lo, b0 = hi - 1; /* code[a0] has the bit clear, code[b0] set */
+    while (b0 - a0 > 1) {
+        int m = a0 + (b0 - a0) / 2;
+        if (code[m] & bit) b0 = m;
+        else a0 = m;
+    }
+    int a = morton_subtree(bp, ids, code, key, lo, b0), b = morton_subtree(bp, ids, code, key, b0, hi);
+    int parent = alloc_node(bp);
+    bp_node *N = bp->nodes;
+    N[parent].child1 = a;
+    N[parent].child2 = b;
+    N[a].parent = N[b].parent = parent;
+    refit(N, parent);
+    return parent;
+}
+
+/* ids[0..count) sorted by Morton code (least significant digit radix sort,
+ * three 10-bit digits; stable, so equal codes keep their order); code gets
+ * the sorted codes. tmp_ids, tmp_code: scratch of count each. */
+static void morton_sort(const bp_node *N, int *ids, uint32_t *code, int *tmp_ids, uint32_t *tmp_code, int count)
+{
+    vec3 cmin = v3_add(N[ids[0]].box.lo, N[ids[0]].box.hi), cmax = cmin; /* centres, doubled */
+    for (int i = 1; i < count; i++) {
+        vec3 c = v3_add(N[ids[i]].box.lo, N[ids[i]].box.hi);
+        cmin = v3_min(cmin, c);
+        cmax = v3_max(cmax, c);
+    }
+    /* cubic cells (one scale for the three axes): a flat world's splits
+     * then go across its long axes first, as median splits would */
+    vec3 span = v3_sub(cmax, cmin);
+    double widest = span.x > span.y ? span.x : span.y;
+    if (span.z > widest) widest = span.z;
+    double scale = widest > 0 ? 1024.0 / widest : 0.0;
+    for (int i = 0; i < count; i++) {
+        vec3 c = v3_add(N[ids[i]].box.lo, N[ids[i]].box.hi);
+        code[i] = spread10(cell10(c.x, cmin.x, scale)) | spread10(cell10(c.y, cmin.y, scale)) << 1 |
+                  spread10(cell10(c.z, cmin.z, scale)) << 2;
+    }
+    int start[1025];
+    for (int shift = 0; shift < 30; shift += 10) {
+        memset(start, 0, sizeof start);
+        for (int i = 0; i < count; i++) start[(code[i] >> shift & 0x3ffu) + 1]++;
+        for (int k = 0; k < 1024; k++) start[k + 1] += start[k];
+        for (int i = 0; i < count; i++) {
+            int at = start[code[i] >> shift & 0x3ffu]++;
+            tmp_ids[at] = ids[i];
+            tmp_code[at] = code[i];
+        }
+        memcpy(ids, tmp_ids, sizeof *ids * (size_t)count);
+        memcpy(code, tmp_code, sizeof *code * (size_t)count);
+    }
+}
+
 int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, const int *user, int n, int *proxy)
 {
     if (n <= 0) return 1;
     if (bp->proxy_count != 0 || n > INT_MAX / 2 - 1) return 0;
-    int *ids = malloc(sizeof *ids * (size_t)n);
-    if (!ids || !reserve_nodes(bp, 2 * n) ||
+    /* ids and their codes, each followed by the radix sort's scratch of n */
+    int *ids = malloc(sizeof *ids * 2 * (size_t)n);
+    uint32_t *code = malloc(sizeof *code * 2 * (size_t)n);
+    if (!ids || !code || !reserve_nodes(bp, 2 * n) ||
         !array_reserve((void **)&bp->moved, &bp->move_capacity, n, sizeof *bp->moved)) {
         free(ids);
+        free(code);
         return 0;
     }
-    double *key = malloc(sizeof *key * (size_t)bp->capacity);
+    double *key = malloc(sizeof *key * (size_t)bp->capacity); /* (median fallback's scratch) */
     if (!key) {
         free(ids);
+        free(code);
         return 0;
     }
     /* the leaves first, in the order given (lowest free ids first), then the inner nodes */
@@ -441,16 +529,22 @@ int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, con
         mark_moved(bp, leaf);
         proxy[i] = leaf;
     }
+    /* Each tree bottom up from the leaves in Z order: one sort by Morton
+     * code and one binary search per inner node, where median splits cost
+     * a quickselect per level (13.3M instructions for a 10,000-body
+     * restore). The trees' shape changes nothing the broadphase reports. */
     for (int tree = 0; tree < 2; tree++) {
         int count = 0;
         for (int i = 0; i < n; i++)
             if (bp->leaves[proxy[i]].tree == tree) ids[count++] = proxy[i];
         if (count == 0) continue;
-        int root = build_subtree(bp, ids, key, 0, count);
+        morton_sort(bp->nodes, ids, code, ids + n, code + n, count);
+        int root = morton_subtree(bp, ids, code, key, 0, count);
         bp->nodes[root].parent = NULL_NODE;
         bp->root[tree] = root;
     }
     free(key);
+    free(code);
     free(ids);
     return 1;
 }
@@ -492,6 +586,21 @@ int bp_tree_height(const broadphase *bp, int is_static)
 {
     int root = bp->root[is_static ? STATIC_TREE : MOVING_TREE];
     return root == NULL_NODE ? -1 : bp->nodes[root].height;
+}
+
+double bp_tree_area(const broadphase *bp, int is_static)
+{
+    /* the inner nodes are the written non-leaves; free ones have height -1 */
+    int root = bp->root[is_static ? STATIC_TREE : MOVING_TREE];
+    double area = 0.0;
+    for (int i = 0; i < bp->fresh; i++) {
+        const bp_node *n = &bp->nodes[i];
+        if (n->height <= 0) continue;
+        int top = i;
+        while (bp->nodes[top].parent != NULL_NODE) top = bp->nodes[top].parent;
+        if (top == root) area += aabb_area(n->box);
+    }
+    return area;
 }
 
 /* Depth-first walk with a local stack that spills to the heap for deep trees. */

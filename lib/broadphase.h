@@ -21,8 +21,8 @@ void bp_destroy(broadphase *bp);
 int bp_create_proxy(broadphase *bp, aabb box, int is_static, int user);
 void bp_destroy_proxy(broadphase *bp, int proxy);
 /* Creates n proxies at once in a broadphase that has none (a snapshot's
- * restore), each tree built top down (median splits) instead of one
- * insertion at a time; proxy[i] gets box[i]'s id. Every new proxy counts as
+ * restore), each tree built bottom up in Z (Morton) order of the boxes'
+ * centres instead of one insertion at a time; proxy[i] gets box[i]'s id. Every new proxy counts as
  * moved. Returns 0 when out of memory, changing nothing. */
 int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, const int *user, int n, int *proxy);
 /* Replaces the proxy's box and marks it moved. */
@@ -43,6 +43,9 @@ void bp_set_moved(broadphase *bp, int proxy, int moved);
 
 /* Height of the static or moving tree (-1 when empty; a single proxy is 0). */
 int bp_tree_height(const broadphase *bp, int is_static);
+/* Summed surface area of the tree's inner nodes (the surface-area cost a
+ * query pays, up to a constant); for tests comparing builds. */
+double bp_tree_area(const broadphase *bp, int is_static);
 /* 1 when every internal invariant holds (links, boxes, heights, counts, moved
  * buffer); for tests. */
 int bp_validate(const broadphase *bp);

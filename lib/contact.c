@@ -230,50 +230,63 @@ int contact_append(contact_set *cs, int a, int b, uint32_t sub)
     return i;
 }
 
+/* A pair's key and index, gathered in one sequential pass over the
+ * contacts: placed in the order of their home slots, the contacts
+ * themselves (136 bytes each) would be read at random, a cache miss each
+ * (most of the map's build time in a 10,000-body restore). */
+typedef struct pair_record {
+    uint32_t hash, sub;
+    int a, b, index;
+} pair_record;
+
 int contact_set_index(contact_set *cs, int *repeated)
 {
     int n = cs->count;
     *repeated = -1;
-    int capacity = 64;
-    while ((n + 1) * 2 > capacity) capacity *= 2;
+    int capacity = 64, bits = 6;
+    while ((n + 1) * 2 > capacity) capacity *= 2, bits++;
+    /* buckets by the top (at most 12) bits of the home slot: each bucket's
+     * slots span a few cache lines, and start[] stays small */
+    int bucket_bits = bits < 12 ? bits : 12, shift = bits - bucket_bits;
     uint32_t mask = (uint32_t)capacity - 1;
     pair_map m;
     int ok = map_init(&m, capacity);
-    int *start = calloc((size_t)capacity + 1, sizeof *start);
-    int *order = malloc(sizeof *order * (size_t)(n > 0 ? n : 1));
-    uint32_t *hash = malloc(sizeof *hash * (size_t)(n > 0 ? n : 1));
-    if (!ok || !start || !order || !hash) {
+    int *start = calloc(((size_t)1 << bucket_bits) + 1, sizeof *start);
+    pair_record *rec = malloc(sizeof *rec * 2 * (size_t)(n > 0 ? n : 1)), *sorted = rec ? rec + n : NULL;
+    if (!ok || !start || !rec) {
         map_free(&m);
         free(start);
-        free(order);
-        free(hash);
+        free(rec);
         return 0;
     }
-    /* the contacts by home slot (counting sort, stable) */
     for (int i = 0; i < n; i++) {
-        hash[i] = contact_hash(&cs->items[i]);
-        start[(hash[i] & mask) + 1]++;
+        const contact *c = &cs->items[i];
+        pair_record *p = &rec[i];
+        p->hash = contact_hash(c);
+        p->sub = c->sub;
+        p->a = c->id_a;
+        p->b = c->id_b;
+        p->index = i;
+        start[((p->hash & mask) >> shift) + 1]++;
     }
-    for (int k = 0; k < capacity; k++) start[k + 1] += start[k];
-    for (int i = 0; i < n; i++) order[start[hash[i] & mask]++] = i;
+    for (int k = 0; k < (1 << bucket_bits); k++) start[k + 1] += start[k];
+    for (int i = 0; i < n; i++) sorted[start[(rec[i].hash & mask) >> shift]++] = rec[i]; /* (stable) */
     pair_map old = cs->map;
     cs->map = m; /* map_slot reads the set's map */
     for (int k = 0; k < n; k++) {
-        int i = order[k];
-        const contact *c = &cs->items[i];
-        int slot = map_slot(cs, hash[i], c->id_a, c->id_b, c->sub);
+        const pair_record *p = &sorted[k];
+        int slot = map_slot(cs, p->hash, p->a, p->b, p->sub);
         if (cs->map.values[slot] >= 0) { /* the later of the two repeats the earlier */
-            int later = i > cs->map.values[slot] ? i : cs->map.values[slot];
+            int later = p->index > cs->map.values[slot] ? p->index : cs->map.values[slot];
             if (*repeated < 0 || later < *repeated) *repeated = later;
             continue;
         }
-        cs->map.hashes[slot] = hash[i];
-        cs->map.values[slot] = i;
+        cs->map.hashes[slot] = p->hash;
+        cs->map.values[slot] = p->index;
         cs->map.count++;
     }
     free(start);
-    free(order);
-    free(hash);
+    free(rec);
     map_free(&old);
     return 1;
 }
