@@ -9,8 +9,12 @@
 static int push_event(carom_world *w, const carom_contact_event *e, int contact_index)
 {
     event_buffer *b = &w->events;
-    if (!array_reserve((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
-    if (!array_reserve((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
+    /* grown to within an eighth, not doubled: a world's first step may raise
+     * a begin event for every contact (131,805 at 50,000 bodies, 14 MB kept
+     * until the next step), and a doubled buffer's unused half is resident
+     * wherever the allocator hands out pages it used before */
+    if (!array_reserve_near((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
+    if (!array_reserve_near((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
     int *children = b->children[b->count];
     children[0] = children[1] = -1;
     b->items[b->count++] = *e;
