@@ -1629,7 +1629,7 @@ typedef struct body_class {
     uint32_t flags;
     vec3 local_center, plane_normal;
     double mass, friction, restitution, linear_damping, angular_damping, gravity_scale;
-    mat3 inertia;
+    mat3 inertia, inv_inertia; /* (the inverse once per class: each body's is the same bits) */
     uint64_t category, mask;
     int group, combine;
     double force_threshold, rolling_resistance;
@@ -1696,6 +1696,7 @@ static int read_class(reader *r, body_class *k)
         return bad(r, "a body class's mass, material, damping or gravity scale is out of range");
     if ((k->flags & BODY_LOCK_PLANE) && fabs(v3_len(k->plane_normal) - 1.0) > 1e-9)
         return bad(r, "a body class's plane normal is not unit");
+    k->inv_inertia = k->type == CAROM_BODY_DYNAMIC ? m3_inverse(k->inertia) : m3_zero();
     k->shape_at = r->pos;
     shape sh;
     int ok = read_shape(r, &sh, type, 0);
@@ -1779,16 +1780,21 @@ static int distinct_classes(reader *r, const body_class *k, int n)
     return 1;
 }
 
-/* "body <i>" (what its errors say), without snprintf's cost per body */
-static void body_label(char what[48], int i)
+/* "body <i>" (what its errors say) from "body <i - 1>", in place: the
+ * last digit counted up, a carry into the ones before it, a new leading 1
+ * after a run of nines (the decimal digits made afresh for every body cost
+ * 90 instructions a body) */
+static void body_label_next(char what[48])
 {
-    char digits[12];
-    int n = 0;
-    unsigned v = (unsigned)i;
-    do digits[n++] = (char)('0' + v % 10); while ((v /= 10) != 0);
-    memcpy(what, "body ", 5);
-    for (int k = 0; k < n; k++) what[5 + k] = digits[n - 1 - k];
-    what[5 + n] = '\0';
+    size_t n = strlen(what);
+    size_t k = n;
+    while (k > 5 && what[k - 1] == '9') what[--k] = '0';
+    if (k > 5) {
+        what[k - 1]++;
+        return;
+    }
+    memmove(what + 6, what + 5, n - 4); /* (the terminator too) */
+    what[5] = '1';
 }
 
 static void free_classes(body_class *classes, int n)
@@ -1858,9 +1864,9 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
     int classes_used = 0;
+    char what[48] = "body 0"; /* the record's name in messages */
     for (int i = 0; i < count; i++) {
-        char what[48];
-        body_label(what, i);
+        if (i > 0) body_label_next(what);
         int bits = get_small(r, 0, REC_ALL, 0, what);
         int ci = get_small(r, 0, class_count - 1, 0, what);
         if (r->failed) break;
@@ -1958,7 +1964,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         /* derived fields, computed as body creation and the setters compute them */
         int dynamic = k->type == CAROM_BODY_DYNAMIC;
         s->inv_mass[i] = dynamic ? 1.0 / s->mass[i] : 0.0;
-        s->inv_inertia_local[i] = dynamic ? m3_inverse(s->inertia_local[i]) : m3_zero();
+        s->inv_inertia_local[i] = k->inv_inertia;
         body_update_inertia(s, i);
     }
     free_classes(classes, class_count);
