@@ -15,9 +15,10 @@
 #include "compound.h"
 
 /* The broadphase reports pairs in the order its trees hold them, which
- * depends on their history; the pairs are added in (id, id) order instead, so
- * the contact order (and the solver's) depends on the bodies alone and a world
- * restored from a snapshot, its trees rebuilt, continues bit for bit. */
+ * depends on their history; the pairs are added in the order of the rule
+ * below instead, so the contact order (and the solver's) depends on the
+ * bodies alone and a world restored from a snapshot, its trees rebuilt,
+ * continues bit for bit. */
 static void collect_pair(void *ctx, int ida, int idb)
 {
     carom_world *w = ctx;
@@ -29,35 +30,100 @@ static void collect_pair(void *ctx, int ida, int idb)
     sc->new_pairs[sc->new_pair_count++] = ((uint64_t)lo << 32) | hi;
 }
 
-static int compare_pairs(const void *a, const void *b)
+/* Which body of a new pair is the solve's body A (the normal points from A
+ * to B, A's frame holds the points' anchors and the friction basis), and the
+ * order new pairs are added to the contact set in, come from the bodies, never
+ * from their ids: a scene then moves the same, to the bit, whatever order
+ * its bodies were made in (issue #16; docs/physics.md 1.1, "Creation order"). A
+ * body ranks before another by, in turn:
+ *   1. its type: static, then kinematic, then dynamic (a floor is always A;
+ *      a box made before its floor of tiles stopped about 1 mm farther as A);
+ *   2. its shape kind (carom_shape_type's order: sphere, box, capsule, ...);
+ *   3. its centre of mass when the pair is made: lower z, then y, then x;
+ *   4. its orientation then: w, x, y, z;
+ * and only two bodies equal in all four (one type and shape kind, the same
+ * centre and orientation to the bit: bodies made inside each other) fall
+ * back to their ids, the one tie the documentation names. -0 and +0 are
+ * equal; a NaN centre (a world the NaN guard resets) compares as equal too
+ * and falls through to the id. Negative: a before b. */
+static inline int rank_cmp(const body_store *s, int a, int b)
 {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
+    if (s->type[a] != s->type[b]) return s->type[a] < s->type[b] ? -1 : 1;
+    if (s->shapes[a].type != s->shapes[b].type) return s->shapes[a].type < s->shapes[b].type ? -1 : 1;
+    vec3 ca = s->center[a], cb = s->center[b];
+    if (ca.z < cb.z) return -1;
+    if (ca.z > cb.z) return 1;
+    if (ca.y < cb.y) return -1;
+    if (ca.y > cb.y) return 1;
+    if (ca.x < cb.x) return -1;
+    if (ca.x > cb.x) return 1;
+    quat qa = s->rotation[a], qb = s->rotation[b];
+    const double ka[4] = {qa.w, qa.x, qa.y, qa.z}, kb[4] = {qb.w, qb.x, qb.y, qb.z};
+    for (int k = 0; k < 4; k++) {
+        if (ka[k] < kb[k]) return -1;
+        if (ka[k] > kb[k]) return 1;
+    }
+    int ia = s->id_index[a], ib = s->id_index[b];
+    return (ia > ib) - (ia < ib);
 }
 
-/* Sorts n pair keys ascending (equal keys are equal values, so the result is
- * the one qsort gave): runs of 16 by insertion, then bottom-up merges
- * through tmp, skipping a merge whose halves are already in order. Inline
- * comparisons instead of qsort's callback: 96M instructions on the
- * 2000-body pile. */
-static void sort_pairs(uint64_t *a, uint64_t *tmp, int n)
+int world_rank_cmp(const body_store *s, int a, int b) { return rank_cmp(s, a, b); }
+
+void world_rank_sort(const body_store *s, int *slots, int *tmp, int n)
 {
     enum { RUN = 16 };
     for (int lo = 0; lo < n; lo += RUN) {
         int hi = lo + RUN < n ? lo + RUN : n;
         for (int i = lo + 1; i < hi; i++) {
+            int x = slots[i], j = i;
+            while (j > lo && rank_cmp(s, slots[j - 1], x) > 0) { slots[j] = slots[j - 1]; j--; }
+            slots[j] = x;
+        }
+    }
+    for (int width = RUN; width < n; width *= 2) {
+        for (int lo = 0; lo + width < n; lo += 2 * width) {
+            int mid = lo + width, hi = lo + 2 * width < n ? lo + 2 * width : n;
+            if (rank_cmp(s, slots[mid - 1], slots[mid]) <= 0) continue;
+            int i = lo, j = mid, k = lo;
+            while (i < mid && j < hi) tmp[k++] = rank_cmp(s, slots[j], slots[i]) < 0 ? slots[j++] : slots[i++];
+            while (i < mid) tmp[k++] = slots[i++];
+            while (j < hi) tmp[k++] = slots[j++];
+            memcpy(slots + lo, tmp + lo, sizeof *slots * (size_t)(hi - lo));
+        }
+    }
+}
+
+/* Ranked pairs of slots (A's slot << 32 | B's slot) in order: by A's rank,
+ * then B's (a total order: equal keys are one pair, reported twice). */
+static inline int pair_cmp(const body_store *s, uint64_t x, uint64_t y)
+{
+    if (x == y) return 0;
+    int c = rank_cmp(s, (int)(x >> 32), (int)(y >> 32));
+    return c ? c : rank_cmp(s, (int)(x & 0xffffffffu), (int)(y & 0xffffffffu));
+}
+
+/* Sorts n ranked pair keys by pair_cmp (a total order, so the result does
+ * not depend on the order the broadphase gave): runs of 16 by insertion,
+ * then bottom-up merges through tmp, skipping a merge whose halves are
+ * already in order; without tmp (out of memory), one insertion run. */
+static void sort_pairs(const body_store *s, uint64_t *a, uint64_t *tmp, int n)
+{
+    const int RUN = tmp ? 16 : n;
+    for (int lo = 0; lo < n; lo += RUN) {
+        int hi = lo + RUN < n ? lo + RUN : n;
+        for (int i = lo + 1; i < hi; i++) {
             uint64_t x = a[i];
             int j = i;
-            while (j > lo && a[j - 1] > x) { a[j] = a[j - 1]; j--; }
+            while (j > lo && pair_cmp(s, a[j - 1], x) > 0) { a[j] = a[j - 1]; j--; }
             a[j] = x;
         }
     }
     for (int width = RUN; width < n; width *= 2) {
         for (int lo = 0; lo + width < n; lo += 2 * width) {
             int mid = lo + width, hi = lo + 2 * width < n ? lo + 2 * width : n;
-            if (a[mid - 1] <= a[mid]) continue; /* already in order */
+            if (pair_cmp(s, a[mid - 1], a[mid]) <= 0) continue; /* already in order */
             int i = lo, j = mid, k = lo;
-            while (i < mid && j < hi) tmp[k++] = a[j] < a[i] ? a[j++] : a[i++];
+            while (i < mid && j < hi) tmp[k++] = pair_cmp(s, a[j], a[i]) < 0 ? a[j++] : a[i++];
             while (i < mid) tmp[k++] = a[i++];
             while (j < hi) tmp[k++] = a[j++];
             memcpy(a + lo, tmp + lo, sizeof *a * (size_t)(hi - lo));
@@ -111,15 +177,31 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     }
     sc->new_pair_count = 0;
     bp_update_pairs(w->bp, collect_pair, w);
-    int np = sc->new_pair_count;
-    if (np > 1) {
-        /* the merge space after the keys; without it (out of memory) qsort */
-        if (array_reserve_near((void **)&sc->new_pairs, &sc->new_pair_capacity, 2 * np, sizeof *sc->new_pairs))
-            sort_pairs(sc->new_pairs, sc->new_pairs + np, np);
-        else
-            qsort(sc->new_pairs, (size_t)np, sizeof *sc->new_pairs, compare_pairs);
+    /* the pairs not in the cache yet (a moved proxy reports every pair it
+     * overlaps), as slots with body A first by rank */
+    int np = 0;
+    for (int i = 0; i < sc->new_pair_count; i++) {
+        uint64_t k = sc->new_pairs[i];
+        int ida = (int)(k >> 32), idb = (int)(k & 0xffffffffu);
+        int sa = s->ids[ida].slot, sb = s->ids[idb].slot;
+        if (sa < 0 || sb < 0 || (s->type[sa] != CAROM_BODY_DYNAMIC && s->type[sb] != CAROM_BODY_DYNAMIC) ||
+            contact_find(&w->contacts, ida, idb) >= 0)
+            continue;
+        if (rank_cmp(s, sa, sb) > 0) { int t = sa; sa = sb; sb = t; }
+        sc->new_pairs[np++] = (uint64_t)(uint32_t)sa << 32 | (uint32_t)sb;
     }
-    for (int i = 0; i < sc->new_pair_count; i++)
+    sc->new_pair_count = np;
+    /* the merge space after the keys; without it (out of memory) insertion */
+    if (np > 1) {
+        int room = array_reserve_near((void **)&sc->new_pairs, &sc->new_pair_capacity, 2 * np, sizeof *sc->new_pairs);
+        sort_pairs(s, sc->new_pairs, room ? sc->new_pairs + np : NULL, np);
+    }
+    /* back to ids before any is added: the pair filter is the user's code */
+    for (int i = 0; i < np; i++) {
+        uint64_t k = sc->new_pairs[i];
+        sc->new_pairs[i] = (uint64_t)(uint32_t)s->id_index[k >> 32] << 32 | (uint32_t)s->id_index[k & 0xffffffffu];
+    }
+    for (int i = 0; i < np; i++)
         add_pair(w, (int)(sc->new_pairs[i] >> 32), (int)(sc->new_pairs[i] & 0xffffffffu));
     return 1;
 }

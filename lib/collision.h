@@ -5,6 +5,14 @@
 
 #include "step.h"
 
+/* The order of two bodies (slots a, b) that does not depend on their ids
+ * (collision.c, docs/physics.md "Creation order"): negative when a ranks
+ * first. A new pair's body A is the one ranked first, and the new pairs are
+ * added in rank order. */
+int world_rank_cmp(const body_store *s, int a, int b);
+/* Sorts n distinct slots by world_rank_cmp (tmp: room for n). */
+void world_rank_sort(const body_store *s, int *slots, int *tmp, int n);
+
 /* Updates the awake bodies' proxies and adds the new broadphase pairs; 0 on out of memory. */
 int world_update_pairs(carom_world *w, const step_context *ctx);
 /* Refreshes every live contact's manifold, lists the touching ones, raises

@@ -40,8 +40,9 @@ static void map_free(pair_map *m)
     free(m->values);
 }
 
-/* The slot holding the contact for (a, b, sub) of hash h, or the empty slot
- * that ends its probe chain. */
+/* The slot holding the contact for (a, b, sub) of hash h (a < b; the
+ * contact holds the pair in either order), or the empty slot that ends its
+ * probe chain. */
 static int map_slot(const contact_set *cs, uint32_t h, int a, int b, uint32_t sub)
 {
     const pair_map *m = &cs->map;
@@ -52,7 +53,8 @@ static int map_slot(const contact_set *cs, uint32_t h, int a, int b, uint32_t su
         if (v < 0) return (int)i;
         if (m->hashes[i] == h) {
             const contact *c = &cs->items[v];
-            if (c->id_a == a && c->id_b == b && c->sub == sub) return (int)i;
+            int lo = c->id_a < c->id_b ? c->id_a : c->id_b, hi = c->id_a < c->id_b ? c->id_b : c->id_a;
+            if (lo == a && hi == b && c->sub == sub) return (int)i;
         }
         i = (i + 1) & mask;
     }
@@ -223,8 +225,8 @@ int contact_append(contact_set *cs, int a, int b, uint32_t sub)
     int i = cs->count++;
     contact *c = &cs->items[i];
     memset(c, 0, sizeof *c);
-    c->id_a = a < b ? a : b;
-    c->id_b = a < b ? b : a;
+    c->id_a = a; /* in the caller's order: body A of the solve first (collision.c) */
+    c->id_b = b;
     c->cache.feature = -1;
     c->sub = sub;
     return i;
@@ -264,8 +266,8 @@ int contact_set_index(contact_set *cs, int *repeated)
         pair_record *p = &rec[i];
         p->hash = contact_hash(c);
         p->sub = c->sub;
-        p->a = c->id_a;
-        p->b = c->id_b;
+        p->a = c->id_a < c->id_b ? c->id_a : c->id_b; /* (map_slot takes the pair as lo, hi) */
+        p->b = c->id_a < c->id_b ? c->id_b : c->id_a;
         p->index = i;
         start[((p->hash & mask) >> shift) + 1]++;
     }

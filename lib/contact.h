@@ -38,7 +38,8 @@ typedef struct contact_point_state {
  * (most are not): the first line holds what a pair with far-apart bounds
  * needs, the second what a pair known to be apart needs. */
 typedef struct contact {
-    int id_a, id_b;             /* body id-table indices, id_a < id_b */
+    int id_a, id_b;             /* body id-table indices: A, the solve's first body, then B, by the
+                                   rule of collision.c (not by id; docs/physics.md) */
     uint32_t flags;
     uint32_t sub;               /* 0: the broadphase pair's contact; k > 0: its k-th extra
                                    manifold (a mesh or height field gives one per normal) */
@@ -103,7 +104,8 @@ int contact_set_init(contact_set *cs);
 void contact_set_free(contact_set *cs);
 /* Index of the contact for (a, b) in any order, or -1. */
 int contact_find(const contact_set *cs, int a, int b);
-/* Adds a contact for a new pair; returns its index or -1 on out of memory. */
+/* Adds a contact for a new pair, a its body A (the order is kept: the
+ * solve's A and B); returns its index or -1 on out of memory. */
 int contact_add(contact_set *cs, int a, int b);
 /* Room for n contacts without growing the arrays (restoring a snapshot: the
  * map is built by contact_set_index). 0 on out of memory. */

@@ -25,6 +25,7 @@
 #include "array.h"
 #include "world.h"
 #include "ghost.h"
+#include "collision.h"
 #include "manifold.h"
 #include "mesh.h"
 #include "heightfield.h"
@@ -91,6 +92,28 @@ static void sort_entries(ghost_entry *a, ghost_entry *tmp, int n)
             while (j < hi) tmp[k++] = a[j++];
             memcpy(a + lo, tmp + lo, sizeof *a * (size_t)(hi - lo));
         }
+    }
+}
+
+/* Within each dynamic body's run of entries, the other bodies in rank order
+ * (world_rank_cmp), not by id: which manifold removes another as a ghost and
+ * which leads a merge must not depend on the order the bodies were made in
+ * (docs/physics.md, "Creation order"). A run is a few entries: insertion. */
+static void rank_others(const body_store *s, ghost_entry *e, int n)
+{
+    for (int first = 0; first < n;) {
+        int last = first + 1;
+        while (last < n && e[last].dynamic == e[first].dynamic) last++;
+        for (int i = first + 1; i < last; i++) {
+            ghost_entry x = e[i];
+            int j = i;
+            while (j > first && world_rank_cmp(s, s->ids[e[j - 1].other].slot, s->ids[x.other].slot) > 0) {
+                e[j] = e[j - 1];
+                j--;
+            }
+            e[j] = x;
+        }
+        first = last;
     }
 }
 
@@ -327,6 +350,7 @@ void world_remove_ghost_contacts(carom_world *w, const step_context *ctx)
         e[n++] = g;
     }
     sort_entries(e, e + n, n);
+    rank_others(s, e, n);
     double tol = GHOST_STEP;
     int removed = 0;
     for (int first = 0; first < n;) {

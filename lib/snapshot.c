@@ -1295,10 +1295,13 @@ static void point_guess(const reuse_motion *m, const contact_data *d, xform xa, 
 /* contact record bits, after the point count (3 bits); a contact's head
  * varint is its flags (6 bits) | bits << 6, so a touching manifold's usual
  * record (count, feature, exact points, cache normal, basis as predicted,
- * flip) fits its first 14 bits: two bytes */
+ * flip) fits its first 14 bits: two bytes. CREC_B_FIRST: the pair's body A
+ * (the solve's first, collision.c) is the higher id of the two written;
+ * without it the lower (as every contact was before the rank rule). */
 enum { CREC_FEATURE = 8, CREC_EXACT = 16, CREC_HAS_NORMAL = 32, CREC_TANGENT_GUESS = 64, CREC_FLIP = 128,
        CREC_NORMAL = 256, CREC_SUB = 512, CREC_SUB_LIMIT = 1024, CREC_TANGENT = 2048, CREC_CACHE_NORMAL = 4096,
-       CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_ALL = 131071 };
+       CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_B_FIRST = 131072,
+       CREC_ALL = 262143 };
 #define CONTACT_FLAG_BITS 6
 /* The flags under which a pair's record has more than its ids, head and
  * cache feature (its data is read, or it is posed) */
@@ -1403,7 +1406,8 @@ SNAP_INLINE unsigned contact_bits(const contact *c, const contact_data *d, conta
                         (posed && !(same_bits(&c->rel_pose.p, &rel->p, sizeof rel->p) && same_bits(&c->rel_pose.q, &rel->q, sizeof rel->q))
                              ? CREC_POSE : 0) |
                         ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
-                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, normal_a, sizeof *normal_a) ? CREC_NORMAL_A : 0);
+                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, normal_a, sizeof *normal_a) ? CREC_NORMAL_A : 0) |
+                        (c->id_a > c->id_b ? CREC_B_FIRST : 0);
 }
 
 static void write_contacts(writer *o, const carom_world *w, const class_table *t)
@@ -1426,10 +1430,11 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
              * basis or material; not posed) */
             size_t at = o->pos;
             unsigned bits = (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
-                            (c->cache.feature != -1 ? CREC_FEATURE : 0);
-            put_varint(o, zigzag((int64_t)c->id_a - last_a));
-            put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
-            last_a = c->id_a;
+                            (c->cache.feature != -1 ? CREC_FEATURE : 0) | (c->id_a > c->id_b ? CREC_B_FIRST : 0);
+            int lo = c->id_a < c->id_b ? c->id_a : c->id_b, hi = c->id_a < c->id_b ? c->id_b : c->id_a;
+            put_varint(o, zigzag((int64_t)lo - last_a));
+            put_varint(o, (uint64_t)(hi - lo - 1));
+            last_a = lo;
             put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
             if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
             acct(o, SNAP_FIELD_contact_header, at);
@@ -1460,9 +1465,10 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
         }
         if (exact) bits |= CREC_EXACT;
         size_t at = o->pos;
-        put_varint(o, zigzag((int64_t)c->id_a - last_a));
-        put_varint(o, (uint64_t)(c->id_b - c->id_a - 1));
-        last_a = c->id_a;
+        int lo = c->id_a < c->id_b ? c->id_a : c->id_b, hi = c->id_a < c->id_b ? c->id_b : c->id_a;
+        put_varint(o, zigzag((int64_t)lo - last_a));
+        put_varint(o, (uint64_t)(hi - lo - 1));
+        last_a = lo;
         put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
         if (bits & CREC_SUB) put_varint(o, c->sub);
         if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
@@ -2015,7 +2021,8 @@ static int read_contacts(reader *r, carom_world *w, const int *class_of)
     contact_set_trim(cs);
     if (repeated >= 0) {
         const contact *c = &cs->items[repeated];
-        return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", repeated, c->id_a, c->id_b, (unsigned)c->sub);
+        return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", repeated, c->id_a < c->id_b ? c->id_a : c->id_b,
+                   c->id_a < c->id_b ? c->id_b : c->id_a, (unsigned)c->sub);
     }
     return 1;
 }
@@ -2048,8 +2055,9 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             ((bits & CREC_POSE) && !posed) || ((bits & CREC_REACH) && !(flags & CONTACT_APART)) ||
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
+        if (bits & CREC_B_FIRST) { int t = a; a = b; b = t; } /* body A first */
         int ci = contact_append(cs, a, b, sub); /* (the pair map is built after the last, contact_set_index) */
-        if (ci >= 0 && !(flags & IDLE_RECORD_FLAGS) && !(bits & ~(CREC_HAS_NORMAL | CREC_FLIP | CREC_FEATURE))) {
+        if (ci >= 0 && !(flags & IDLE_RECORD_FLAGS) && !(bits & ~(CREC_HAS_NORMAL | CREC_FLIP | CREC_FEATURE | CREC_B_FIRST))) {
             /* a pair without data, not posed, of the first manifold (the
              * writer's short record): nothing more to read, and what the
              * general path below would check holds (its bits are its cache's) */

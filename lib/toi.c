@@ -30,6 +30,7 @@
 #include "heightfield.h"
 #include "world.h"
 #include "toi.h"
+#include "collision.h"
 
 #define TOI_MAX_ITERATIONS 64
 /* how far a touching pair may sink within a step before its sweep stops it
@@ -126,6 +127,7 @@ typedef struct toi_context {
     int slot;             /* the body being swept */
     double target, slop;  /* separation to stop at, allowed extra sinking of a touching pair */
     int changed;
+    int *near, near_count; /* the slots the swept body's query found (room for every slot) */
 } toi_context;
 
 static xform pose_at(const carom_world *w, const sweep *sw, double f, int slot, double t)
@@ -331,24 +333,30 @@ static double pair_toi(const toi_context *ctx, int a, int b, double limit)
     return t; /* not converged: stop where the advancement got (never past contact) */
 }
 
-static int sweep_against(void *user, int id_index)
+/* The swept body's query collects the bodies near its path; they are swept
+ * against after it, in rank order (sweep_against). */
+static int collect_near(void *user, int id_index)
 {
     toi_context *ctx = user;
+    int other = ctx->w->bodies.ids[id_index].slot;
+    if (other >= 0 && other != ctx->slot) ctx->near[ctx->near_count++] = other;
+    return 1;
+}
+
+static void sweep_against(toi_context *ctx, int other)
+{
     const body_store *s = &ctx->w->bodies;
-    int other = s->ids[id_index].slot;
     int self = ctx->slot;
-    if (other < 0 || other == self) return 1;
-    if ((s->flags[other] | s->flags[self]) & BODY_SENSOR) return 1; /* sensors never stop a body */
-    if (!filter_pair_allowed(ctx->w, self, other)) return 1; /* the bits and the world's pair filter */
+    if ((s->flags[other] | s->flags[self]) & BODY_SENSOR) return; /* sensors never stop a body */
+    if (!filter_pair_allowed(ctx->w, self, other)) return; /* the bits and the world's pair filter */
     double limit = ctx->fraction[self];
     /* a moving dynamic body can be stopped too: meeting sooner binds it */
     int other_stops = s->type[other] == CAROM_BODY_DYNAMIC && ctx->sweeps[other].moving;
     if (other_stops) limit = dmax(limit, ctx->fraction[other]);
-    if (!(limit > 0.0)) return 1;
+    if (!(limit > 0.0)) return;
     double t = pair_toi(ctx, self, other, limit);
     if (t < ctx->fraction[self]) { ctx->fraction[self] = t; ctx->changed = 1; }
     if (other_stops && t < ctx->fraction[other]) { ctx->fraction[other] = t; ctx->changed = 1; }
-    return 1;
 }
 
 static sweep make_sweep(const carom_world *w, const step_context *step, int slot)
@@ -413,8 +421,9 @@ int world_continuous(carom_world *w, const step_context *step)
     int any = 0;
     for (int i = 0; i < n && !any; i++) any = may_need_sweep(w, step, i);
     if (!any) return 1;
-    /* per slot: the sweep, the stop fraction and whether it is swept */
-    size_t need = (sizeof(sweep) + sizeof(double) + sizeof(int)) * (size_t)(n > 0 ? n : 1);
+    /* per slot: the sweep, the stop fraction, the swept bodies and the near
+     * ones of one sweep (each with the merge space of its sort) */
+    size_t need = (sizeof(sweep) + sizeof(double) + 4 * sizeof(int)) * (size_t)(n > 0 ? n : 1);
     if (sc->toi_capacity < need) {
         void *p = realloc(sc->toi, need);
         if (!p) return 0;
@@ -437,7 +446,12 @@ int world_continuous(carom_world *w, const step_context *step)
         fast[fast_count++] = i;
     }
     if (fast_count == 0) return 1;
-    toi_context ctx = {w, sweeps, fraction, -1, 0.5 * TOI_SINK, TOI_SINK, 1};
+    /* swept in rank order (collision.c), not by slot, and each against the
+     * bodies near its path in rank order, not the tree's: a body stopped by
+     * one pair is stopped sooner for later ones, so the order must not
+     * follow creation (docs/physics.md, "Creation order") */
+    world_rank_sort(s, fast, fast + n, fast_count);
+    toi_context ctx = {w, sweeps, fraction, -1, 0.5 * TOI_SINK, TOI_SINK, 1, fast + 2 * n, 0};
     for (int pass = 0; pass < TOI_MAX_PASSES && ctx.changed; pass++) {
         ctx.changed = 0;
         for (int k = 0; k < fast_count; k++) {
@@ -448,7 +462,10 @@ int world_continuous(carom_world *w, const step_context *step)
             vec3 c1 = v3_add(sw->c0, sw->dc);
             double r = sw->reach + ctx.target;
             aabb box = {v3_sub(v3_min(sw->c0, c1), v3(r, r, r)), v3_add(v3_max(sw->c0, c1), v3(r, r, r))};
-            bp_query(w->bp, box, sweep_against, &ctx);
+            ctx.near_count = 0;
+            bp_query(w->bp, box, collect_near, &ctx);
+            world_rank_sort(s, ctx.near, ctx.near + n, ctx.near_count);
+            for (int j = 0; j < ctx.near_count; j++) sweep_against(&ctx, ctx.near[j]);
         }
     }
     for (int i = 0; i < n; i++) {

@@ -555,9 +555,10 @@ static void test_field_bytes_add_up(void **state)
 }
 
 /* The restore path's pair map, built at once in the order of the contacts'
- * home slots: every contact found at its index, whatever the count (the
- * map doubles through several sizes), and a repeated pair or sub named by
- * the later of the two. */
+ * home slots: every contact found at its index by its pair in either order,
+ * whatever the count (the map doubles through several sizes), its bodies
+ * kept in the order given (body A first), and a repeated pair or sub named
+ * by the later of the two. */
 static void test_restored_pair_map(void **state)
 {
     (void)state;
@@ -577,12 +578,13 @@ static void test_restored_pair_map(void **state)
         for (int i = 0; i < n; i++) {
             int a = (i * 7919) % 3001, b = 3001 + i / 3;
             assert_int_equal(contact_find_sub(&cs, a, b, (uint32_t)(i % 3)), i);
-            assert_int_equal(cs.items[i].id_a, a);
-            assert_int_equal(cs.items[i].id_b, b);
+            assert_int_equal(contact_find_sub(&cs, b, a, (uint32_t)(i % 3)), i);
+            assert_int_equal(cs.items[i].id_a, b); /* kept as given: body A first (collision.c's rank) */
+            assert_int_equal(cs.items[i].id_b, a);
         }
         assert_int_equal(contact_find_sub(&cs, 0, 3001, 7), -1);
-        if (n >= 31) { /* a copy of contact 5 appended, then one of contact 2 with another sub (not a repeat) */
-            assert_int_equal(contact_append(&cs, cs.items[5].id_a, cs.items[5].id_b, cs.items[5].sub), n);
+        if (n >= 31) { /* a copy of contact 5 appended (its bodies swapped: the same pair), then one of contact 2 with another sub (not a repeat) */
+            assert_int_equal(contact_append(&cs, cs.items[5].id_b, cs.items[5].id_a, cs.items[5].sub), n);
             assert_int_equal(contact_append(&cs, cs.items[2].id_a, cs.items[2].id_b, cs.items[2].sub + 10), n + 1);
             assert_true(contact_set_index(&cs, &repeated));
             assert_int_equal(repeated, n);
