@@ -4,12 +4,11 @@
  * share are in constraint.h. */
 #include "contact_solver.h"
 #include "penalty.h"
+#include "block_ldl.h"
 
 #if defined(__GNUC__)
-#define SOLVE_INLINE static inline __attribute__((always_inline))
 #define SOLVE_OUTLINE static __attribute__((noinline))
 #else
-#define SOLVE_INLINE static inline
 #define SOLVE_OUTLINE static
 #endif
 
@@ -101,45 +100,6 @@ static void solve_rolling(contact_constraint *c, vec3 *wA, vec3 *wB, const impul
  * tilted on a point or two that toggled between touching and apart never
  * settled: of 48 random piles of 30 boxes, 23 still moved after 20 s at
  * default (3 with this), 6 at accurate (1). */
-#define BLOCK_EPS 1e-9
-
-/* LDL^T factor of an n x n positive definite A: L (unit diagonal) below the
- * diagonal, 1 / D_ii on it; 0 when a pivot is not positive. */
-SOLVE_INLINE int block_factor_n(int n, double A[4][4], double L[4][4])
-{
-    double d[4], u[4][4]; /* u[i][k] = L_ik D_kk */
-    for (int i = 0; i < n; i++) {
-        for (int j = 0; j < i; j++) {
-            double sum = A[i][j];
-            for (int k = 0; k < j; k++) sum -= u[i][k] * L[j][k];
-            u[i][j] = sum;
-            L[i][j] = sum * L[j][j];
-        }
-        double sum = A[i][i];
-        for (int k = 0; k < i; k++) sum -= u[i][k] * L[i][k];
-        if (!(sum > 0.0)) return 0;
-        d[i] = sum;
-        L[i][i] = 1.0 / d[i];
-    }
-    return 1;
-}
-
-/* x = A^-1 r from block_factor's L. */
-SOLVE_INLINE void block_apply_n(int n, double L[4][4], const double r[4], double x[4])
-{
-    double y[4];
-    for (int i = 0; i < n; i++) {
-        double sum = r[i];
-        for (int k = 0; k < i; k++) sum -= L[i][k] * y[k];
-        y[i] = sum;
-    }
-    for (int i = n - 1; i >= 0; i--) {
-        double sum = y[i] * L[i][i];
-        for (int k = i + 1; k < n; k++) sum -= L[k][i] * x[k];
-        x[i] = sum;
-    }
-}
-
 /* The two above with n a constant in each case, so the loops unroll. */
 static int block_factor(int n, double A[4][4], double L[4][4])
 {
@@ -154,14 +114,7 @@ static void block_apply(int n, double L[4][4], const double r[4], double x[4])
 {
     /* spelled out for 4 points (faces, the common case): GCC at -O2 left the loops rolled */
     if (n == 4) {
-        double y0 = r[0];
-        double y1 = r[1] - L[1][0] * y0;
-        double y2 = r[2] - L[2][0] * y0 - L[2][1] * y1;
-        double y3 = r[3] - L[3][0] * y0 - L[3][1] * y1 - L[3][2] * y2;
-        x[3] = y3 * L[3][3];
-        x[2] = y2 * L[2][2] - L[3][2] * x[3];
-        x[1] = y1 * L[1][1] - L[2][1] * x[2] - L[3][1] * x[3];
-        x[0] = y0 * L[0][0] - L[1][0] * x[1] - L[2][0] * x[2] - L[3][0] * x[3];
+        block_apply4(L, r, x);
         return;
     }
     block_apply_n(n, L, r, x);
@@ -232,7 +185,11 @@ static int block_lcp(int n, double A[4][4], const double b[4], double x[4], int 
  * (accurate) the cap is 4 and the limit max(f, 1/(2h)). A manifold past
  * 1/(4h) is marked
  * stiff: the pass that solves it is followed by BLOCK_STIFF_SWEEPS sweeps
- * of the stiff manifolds' normal rows alone (solver.c). Without them one
+ * of the stiff manifolds' normal rows alone (solver.c), unless its column's
+ * direct solve (column_solve.c) took its normal rows this pass. A manifold
+ * of such a column takes the same rule at one iteration (default): the
+ * direct solve holds the stiffer springs (the sweeps stay the fallback for
+ * a pass it leaves to the manifolds). Without them one
  * Gauss-Seidel pass does not hold such a spring: past 1/(4h) every tower
  * walked sideways (a stack's tilt modes, each point its own spring, swing at
  * 1.22 f and grew from rounding: 1.25/(4h) held, 1.5/(4h) walked the
@@ -249,7 +206,7 @@ static int block_lcp(int n, double A[4][4], const double b[4], double x[4], int 
  * caller keeps c->soft). */
 #define BLOCK_STIFFENING_MAX 4.0
 static int block_loaded_softness(const contact_constraint *c, const step_context *ctx, double mA, double mB,
-                                 softness *out, int *stiff)
+                                 int column, softness *out, int *stiff)
 {
     *stiff = 0;
     if (!(ctx->relax_iterations > 0 && ctx->warm_starting && ctx->gravity_length > 0.0 && mA + mB > 0.0)) return 0;
@@ -257,10 +214,12 @@ static int block_loaded_softness(const contact_constraint *c, const step_context
     double load = 0.0;
     for (int j = 0; j < c->count; j++) load += c->p[j].normal_impulse; /* last step's (warm starting on) */
     double ratio = load * (mA + mB) / (ctx->h * ctx->gravity_length);
-    /* past 1/(4h) only with two iterations or more: at one the sweeps would
-     * run nearly everywhere (the 10-box stack at default: 137.6M -> 258.5M
-     * instructions, callgrind, for a column it already holds to 0.69 cm) */
-    int past = ctx->iterations >= 2;
+    /* past 1/(4h) only where something holds it: a column's direct solve
+     * (column_solve.c), or with two iterations or more the sweeps; at one
+     * iteration sweeps would run nearly everywhere (the 10-box stack at
+     * default: 137.6M -> 258.5M instructions, callgrind, for a column it
+     * already holds to 0.69 cm) */
+    int past = ctx->iterations >= 2 || column;
     double f = dmin(sqrt(1.0 + ratio), past ? BLOCK_STIFFENING_MAX : 2.0);
     if (!(f > 1.4142135623730951)) return 0; /* loaded_softness's own answer */
     double hertz = (mA == 0.0 || mB == 0.0 ? 2.0 : 1.0) * ctx->contact_hertz;
@@ -269,13 +228,6 @@ static int block_loaded_softness(const contact_constraint *c, const step_context
     *stiff = stiffened > dmax(hertz, quarter);
     *out = make_softness(stiffened, ctx->contact_damping_ratio, ctx->h);
     return 1;
-}
-
-/* The soft rows' compliance factor gamma: c_i = gamma K_ii (0: rigid rows). */
-static double block_gamma(const contact_constraint *c, const step_context *ctx)
-{
-    int soft = ctx->correction == CAROM_CORRECTION_SOFT;
-    return soft && c->soft.mass_scale > 0.0 ? c->soft.impulse_scale / c->soft.mass_scale : 0.0;
 }
 
 /* K of an unlocked manifold of 2-4 points (after its rows); the factors
@@ -288,10 +240,11 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
     blk->factored[0] = blk->factored[1] = 0;
     blk->shock_ready = 0;
     blk->stiff = 0;
+    blk->column_done = 0;
     if (count < 2 || c->locked) return;
     softness setting = c->soft; /* kept for a manifold that ends up swept */
     int stiff;
-    block_loaded_softness(c, ctx, mA, mB, &c->soft, &stiff);
+    block_loaded_softness(c, ctx, mA, mB, blk->column, &c->soft, &stiff);
     for (int i = 0; i < count; i++) {
         const constraint_rows *p = &c->r[i];
         if (!(p->normal_mass > 0.0)) {
@@ -316,7 +269,7 @@ static void block_prepare(contact_constraint *c, contact_block *blk, const step_
 SOLVE_OUTLINE void block_make_factor(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft)
 {
     const int count = c->count;
-    double e = (soft ? block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
+    double e = (soft ? contact_block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
     for (int i = 0; i < count; i++) {
         for (int j = 0; j < count; j++) A[i][j] = blk->K[i][j];
         A[i][i] += e * blk->K[i][i];
@@ -324,7 +277,7 @@ SOLVE_OUTLINE void block_make_factor(const contact_constraint *c, contact_block 
     blk->factored[soft] = block_factor(count, A, blk->inv[soft]) ? 1 : -1;
 }
 
-SOLVE_INLINE double (*block_inverse(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft))[4]
+BLOCK_INLINE double (*block_inverse(const contact_constraint *c, contact_block *blk, const step_context *ctx, int soft))[4]
 {
     if (!blk->factored[soft]) block_make_factor(c, blk, ctx, soft);
     return blk->factored[soft] > 0 ? blk->inv[soft] : NULL;
@@ -361,7 +314,7 @@ static int block_totals(int count, double K[4][4], double inv[4][4], const doubl
 
 /* The normal rows of an unlocked manifold of 2-4 points solved as a block;
  * 0 (nothing changed) when the caller must sweep them instead. */
-SOLVE_INLINE int solve_normals_block(contact_constraint *c, contact_block *blk, const step_context *ctx, int use_bias,
+BLOCK_INLINE int solve_normals_block(contact_constraint *c, contact_block *blk, const step_context *ctx, int use_bias,
                                vec3 *vA, vec3 *wA, vec3 *vB, vec3 *wB, double mA, double mB)
 {
     const int count = c->count;
@@ -370,7 +323,7 @@ SOLVE_INLINE int solve_normals_block(contact_constraint *c, contact_block *blk, 
     vec3 dqa = ctx->dq[c->a], dqb = ctx->dq[c->b];
     int soft = ctx->correction == CAROM_CORRECTION_SOFT;
     int push = use_bias && (soft || ctx->correction == CAROM_CORRECTION_BAUMGARTE);
-    double gamma = block_gamma(c, ctx) + BLOCK_EPS;
+    double gamma = contact_block_gamma(c, ctx) + BLOCK_EPS;
     double vb[4], e[4], x[4], acc[4];
     int soft_rows = 0;
     for (int i = 0; i < count; i++) {
@@ -503,7 +456,7 @@ void contact_warm_start(contact_constraint *c, impulse_body *bodies)
 /* contact_solve's body, built twice: `locked` (a constant in each build)
  * keeps plane-locked bodies' velocities in their planes after every row; the
  * build for free bodies carries none of it. */
-SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces,
+BLOCK_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx, int use_bias, int hold_bounces,
                                  const int locked)
 {
     impulse_body *A = &ctx->bodies[c->a], *B = &ctx->bodies[c->b];
@@ -518,8 +471,9 @@ SOLVE_INLINE void solve_manifold(contact_constraint *c, const step_context *ctx,
     vec3 lock_a = v3_zero(), lock_b = v3_zero();
     if (locked) { lock_a = c->x->lock_a; lock_b = c->x->lock_b; }
     contact_block *blk = ctx->blocks ? &ctx->blocks[c - ctx->constraints] : NULL;
-    int blocked = !locked && blk && blk->ready && !(hold_bounces && c->restitution > 0.0) &&
-                  solve_normals_block(c, blk, ctx, use_bias, &vA, &wA, &vB, &wB, mA, mB);
+    int blocked = !locked && blk && blk->ready &&
+                  (blk->column_done || (!(hold_bounces && c->restitution > 0.0) &&
+                                        solve_normals_block(c, blk, ctx, use_bias, &vA, &wA, &vB, &wB, mA, mB)));
     for (int i = 0; i < count && !blocked; i++) {
         constraint_point *p = &c->p[i];
         const constraint_rows *r = &c->r[i];

@@ -17,7 +17,16 @@ typedef struct contact_block {
     int factored[2];             /* inv[k]: 1 made, -1 failed, 0 not yet */
     int shock_ready;
     int stiff;                   /* springs past a quarter of the sub-step rate: swept again (contact_solve_normals) */
+    int column;                  /* in a column solved directly (column_solve.c; set before prepare) */
+    int column_done;             /* this pass's normal rows already solved by its column */
 } contact_block;
+
+/* The soft rows' compliance factor gamma: c_i = gamma K_ii (0: rigid rows). */
+static inline double contact_block_gamma(const contact_constraint *c, const step_context *ctx)
+{
+    int soft = ctx->correction == CAROM_CORRECTION_SOFT;
+    return soft && c->soft.mass_scale > 0.0 ? c->soft.impulse_scale / c->soft.mass_scale : 0.0;
+}
 
 /* Anchors, rows, effective masses, warm impulses and the approach velocity
  * of one manifold's points; returns its deepest overlap. */

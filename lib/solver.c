@@ -33,6 +33,7 @@
 #include "world.h"
 #include "solver.h"
 #include "contact_solver.h"
+#include "column_solve.h"
 #include "solver_wide.h"
 #include "penalty.h"
 #include "rotation.h"
@@ -61,6 +62,7 @@ typedef struct solver_work {
     int points;
     int locked;                  /* constraints with a plane-locked body */
     int stiff;                   /* scalar manifolds marked stiff (contact_block.stiff) */
+    column_memory *columns;      /* the columns solved directly (column_solve.c) */
 } solver_work;
 
 /* What the sub-steps read of a solver body, computed once per step from the
@@ -906,13 +908,16 @@ static void warm_start(const step_context *ctx, const solver_work *work)
 static void solve_pass(const step_context *ctx, const solver_work *work, int use_bias, int hold_bounces)
 {
     if (work->wide) wide_solve(work->wide, ctx, use_bias, hold_bounces);
+    int stiff = work->stiff; /* stiff manifolds that no column solved this pass */
+    if (work->columns->count > 0) stiff += column_solve_pass(work->columns, ctx, use_bias, hold_bounces);
     for (int k = 0; k < work->scalar_count; k++)
         contact_solve(scalar_constraint(ctx, work, k), ctx, use_bias, hold_bounces);
     /* the stiff manifolds' normal rows again (contact_solver.c, block_loaded_softness) */
-    for (int e = 0; e < BLOCK_STIFF_SWEEPS && work->stiff > 0; e++) {
+    for (int e = 0; e < BLOCK_STIFF_SWEEPS && stiff > 0; e++) {
         for (int k = 0; k < work->scalar_count; k++) {
             contact_constraint *c = scalar_constraint(ctx, work, k);
-            if (ctx->blocks[c - ctx->constraints].stiff) contact_solve_normals(c, ctx, use_bias);
+            const contact_block *blk = &ctx->blocks[c - ctx->constraints];
+            if (blk->stiff && !blk->column_done) contact_solve_normals(c, ctx, use_bias);
         }
     }
 }
@@ -1216,6 +1221,7 @@ void solver_memory_free(solver_memory *m)
     free(m->last_order);
     free(m->mark);
     free(m->motion);
+    column_memory_free(&m->columns);
     memset(m, 0, sizeof *m);
 }
 
@@ -1226,7 +1232,10 @@ int world_solve(carom_world *w, step_context *ctx)
     if (!gather_bodies(w, ctx, &work) || !build_constraints(w, ctx, &work)) return 0;
     plan_shock(ctx, &work);
     if (!plan_wide(w, ctx, &work) || !attach_rows(w, ctx, &work)) return 0;
+    work.columns = &w->scratch.solver.columns;
+    if (!column_find(work.columns, ctx, work.scalar, work.scalar_count)) return 0;
     prepare_points(ctx, &work);
+    work.stiff -= column_prepare(work.columns, ctx);
     if (!check_penalty(w, ctx)) return -1;
     if (!resolve_impacts(w, ctx, &work)) return 0;
     for (int step = 0; step < ctx->substeps; step++) {

@@ -4,6 +4,7 @@
 #define CAROM_SOLVER_H
 
 #include "step.h"
+#include "column_solve.h"
 
 /* The solver's memory, kept between steps in the world's scratch. */
 typedef struct solver_memory {
@@ -34,6 +35,7 @@ typedef struct solver_memory {
     int bodies_capacity;         /* step_scratch.bodies' (gather_bodies) */
     int planar;                  /* this step: some awake body is locked to a plane */
     int rotation_locked;         /* this step: some awake body is rotation-locked (spinless manifolds may exist) */
+    column_memory columns;       /* this step's columns solved directly (column_solve.c) */
 } solver_memory;
 void solver_memory_free(solver_memory *m);
 
