@@ -144,8 +144,17 @@ static void triangle_core(const vec3 v[3], vec3 n, unsigned active, vec3 c0, vec
     vec3 nrm;
     double sep;
     if (!feature_active || dist < 1e-12) {
-        nrm = n; /* an internal edge: the neighbour's face continues this one */
-        sep = v3_dot(n, v3_sub(pc, q)) - r;
+        /* an internal edge: the neighbour's face continues this one, so the
+         * face normal; but the true distance, not the height over this
+         * face's plane (never more room along the normal than there is,
+         * never deeper than the feature itself). A triangle does not know
+         * where its neighbours end: a sphere rolled off a terrain mesh's
+         * border, its centre 0.27 m past the border edge, was 0.033 m
+         * "deep" under the plane of a triangle whose edges and vertex at
+         * that corner are all internal, and was thrown back up. The
+         * neighbour's own face contact holds a core over it. */
+        nrm = n;
+        sep = dist - r;
     } else {
         nrm = v3_scale(v3_sub(pc, q), 1.0 / dist);
         sep = dist - r;
@@ -618,6 +627,17 @@ int manifold_outline(manifold_point *pts, int n, vec3 normal)
     if (h < 3) return n; /* all on a line: leave them to the reduction */
     manifold_point kept[GROUP_CAPACITY];
     for (int i = 0; i < h; i++) kept[i] = pts[hull[i]];
+    /* on a plane no point inside is deeper than every corner; on a curved
+     * surface one can be, and it stays (the reduction keeps the deepest):
+     * a sphere's points from several triangles, all on the line through its
+     * centre, made a "hull" of rounding noise that left out the one 0.027 m
+     * deep, for one 0.014 m above */
+    int deepest = 0;
+    double kept_low = 1e300;
+    for (int i = 1; i < n; i++)
+        if (pts[i].separation < pts[deepest].separation) deepest = i;
+    for (int i = 0; i < h; i++) kept_low = dmin(kept_low, kept[i].separation);
+    if (pts[deepest].separation < kept_low - 1e-6 && h < GROUP_CAPACITY) kept[h++] = pts[deepest];
     for (int i = 0; i < h; i++) pts[i] = kept[i];
     return h;
 }
@@ -727,37 +747,62 @@ static int visit_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t 
     return 1;
 }
 
-/* Points all on one line (a cylinder on its side, a box's edge, across
- * several triangles): its two ends only, as a plane gives. Four points on a
- * line make the manifold's normal rows singular for the block solve: a
+/* Points all on one line (a cylinder on its side, a box's edge, a capsule,
+ * across several triangles): two points only, as a plane gives. Four points
+ * on a line make the manifold's normal rows singular for the block solve: a
  * cylinder rolling on a flat mesh at `fast` moved 1.6 mm/s vertically, on a
- * plane 1.7e-11. */
+ * plane 1.7e-11.
+ * The two are the line's ends, each the deepest of the points at that end,
+ * where the points are placed at the shape's own surface (a point is midway
+ * between the shapes: the same end of a capsule's core over two triangles
+ * is two points, one deep over the triangle under it, one shallow beside
+ * the next, half their separations apart along the normal, which a tilted
+ * normal turns into millimetres along the line; taking the farther one, a
+ * capsule lying across a hillside lost its deepest point, 0.020 m deep,
+ * and sank to 0.028 m the next step). And on a curved surface the deepest
+ * point can lie between the ends (a ridge under the middle): deeper than
+ * both ends by more than 1 um, it takes the place of the nearer end, so no
+ * manifold ever leaves out its deepest point. */
+static vec3 line_position(const manifold_point *mp, vec3 normal)
+{
+    vec3 p = v3_madd(mp->point, 0.5 * mp->separation, normal); /* on the shape */
+    return v3_madd(p, -v3_dot(p, normal), normal);
+}
+
 static int keep_line_ends(manifold_point *pts, int n, vec3 normal)
 {
     if (n <= 2) return n;
+    vec3 at[GROUP_CAPACITY];
+    if (n > GROUP_CAPACITY) n = GROUP_CAPACITY;
+    for (int i = 0; i < n; i++) at[i] = line_position(&pts[i], normal);
     int a = 0, b = 0;
     double best = -1;
-    for (int i = 1; i < n; i++) {
-        vec3 d = v3_sub(pts[i].point, pts[0].point);
-        d = v3_madd(d, -v3_dot(d, normal), normal);
-        if (v3_len2(d) > best) { best = v3_len2(d); a = i; }
-    }
+    for (int i = 1; i < n; i++)
+        if (v3_len2(v3_sub(at[i], at[0])) > best) { best = v3_len2(v3_sub(at[i], at[0])); a = i; }
     best = -1;
-    for (int i = 0; i < n; i++) {
-        vec3 d = v3_sub(pts[i].point, pts[a].point);
-        d = v3_madd(d, -v3_dot(d, normal), normal);
-        if (v3_len2(d) > best) { best = v3_len2(d); b = i; }
-    }
-    vec3 ab = v3_sub(pts[b].point, pts[a].point);
-    ab = v3_madd(ab, -v3_dot(ab, normal), normal);
+    for (int i = 0; i < n; i++)
+        if (v3_len2(v3_sub(at[i], at[a])) > best) { best = v3_len2(v3_sub(at[i], at[a])); b = i; }
+    vec3 ab = v3_sub(at[b], at[a]);
     double l2 = v3_len2(ab);
     if (!(l2 > 1e-18)) return n;
     for (int i = 0; i < n; i++) {
-        vec3 d = v3_sub(pts[i].point, pts[a].point);
-        vec3 off = v3_cross(ab, v3_madd(d, -v3_dot(d, normal), normal)); /* |ab| times the distance off the line */
+        vec3 off = v3_cross(ab, v3_sub(at[i], at[a])); /* |ab| times the distance off the line */
         if (v3_len2(off) > 1e-12 * l2 * l2) return n; /* farther than 1e-6 of the length: not a line */
     }
-    manifold_point ends[2] = {pts[a], pts[b]};
+    /* each end: the deepest point there (within 1e-6 of the length) */
+    int ea = a, eb = b;
+    for (int i = 0; i < n; i++) {
+        if (v3_len2(v3_sub(at[i], at[a])) <= 1e-12 * l2 && pts[i].separation < pts[ea].separation) ea = i;
+        if (v3_len2(v3_sub(at[i], at[b])) <= 1e-12 * l2 && pts[i].separation < pts[eb].separation) eb = i;
+    }
+    /* the deepest point between them, if deeper than both by more than 1 um */
+    int low = -1;
+    double lowest = dmin(pts[ea].separation, pts[eb].separation) - 1e-6;
+    for (int i = 0; i < n; i++)
+        if (pts[i].separation < lowest) { lowest = pts[i].separation; low = i; }
+    manifold_point ends[2] = {pts[ea], pts[eb]};
+    if (low >= 0) /* it and the end farther from it */
+        ends[v3_len2(v3_sub(at[low], at[ea])) < v3_len2(v3_sub(at[low], at[eb])) ? 0 : 1] = pts[low];
     pts[0] = ends[0];
     pts[1] = ends[1];
     return 2;

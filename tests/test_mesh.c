@@ -531,11 +531,23 @@ static void test_triangle_edges_and_vertices(void **state)
     vec3 expect = v3_normalize(v3_sub(x.p, c));
     assert_true(v3_len(v3_sub(m.normal, expect)) < 1e-9);
     assert_true(fabs(m.points[0].separation - (v3_len(v3_sub(x.p, c)) - s.radius)) < 1e-9);
-    /* the same edge internal: the face normal, the separation along it */
+    /* the same edge internal: the face normal, the true distance (the
+     * neighbour's face, coplanar across an internal edge, holds the core
+     * over it at its height) */
     collide_triangle(tri, 6u, 0, &s, x, 0.05, &m);
     assert_int_equal(m.count, 1);
     assert_true(fabs(m.normal.z - 1) < 1e-12);
-    assert_true(fabs(m.points[0].separation - (0.15 - s.radius)) < 1e-12);
+    assert_true(fabs(m.points[0].separation - (v3_len(v3_sub(x.p, c)) - s.radius)) < 1e-12);
+    /* past a corner whose edges are all internal, low beside it, as past a
+     * terrain's border where the neighbour holding that corner's boundary
+     * edge ends: 0.2 m from the corner, nothing within the look-ahead (the
+     * height over the face's plane said 0.2 m deep) */
+    x.p = v3(-0.35, -0.35, 0.1);
+    collide_triangle(tri, 0u, 0, &s, x, 0.05, &m);
+    assert_int_equal(m.count, 0);
+    collide_triangle(tri, 0u, 0, &s, x, 0.25, &m); /* within a longer look-ahead: the true distance */
+    assert_true(m.count == 1 && fabs(m.normal.z - 1) < 1e-12);
+    assert_true(fabs(m.points[0].separation - (v3_len(x.p) - s.radius)) < 1e-12);
     /* past vertex 0: active while either edge there is */
     x.p = v3(-0.15, -0.15, 0.1);
     collide_triangle(tri, 1u, 0, &s, x, 0.05, &m);
@@ -629,6 +641,122 @@ static void test_seam_pass_judges_locally(void **state)
     printf("  sphere over the plate: lowest centre %.4f m above its top (radius 0.2)\n", lowest);
     assert_true(lowest > 0.2 - 0.005);
     carom_world_destroy(w);
+}
+
+/* Closest point of triangle v to p (Ericson's region tests), for the brute
+ * force below. */
+static vec3 closest_on_triangle(vec3 p, const vec3 v[3])
+{
+    vec3 ab = v3_sub(v[1], v[0]), ac = v3_sub(v[2], v[0]), ap = v3_sub(p, v[0]);
+    double d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return v[0];
+    vec3 bp = v3_sub(p, v[1]);
+    double d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return v[1];
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return v3_madd(v[0], d1 / (d1 - d3), ab);
+    vec3 cp = v3_sub(p, v[2]);
+    double d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return v[2];
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return v3_madd(v[0], d2 / (d2 - d6), ac);
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+        return v3_madd(v[1], (d4 - d3) / ((d4 - d3) + (d5 - d6)), v3_sub(v[2], v[1]));
+    double den = 1.0 / (va + vb + vc);
+    return v3_add(v[0], v3_add(v3_scale(ab, vb * den), v3_scale(ac, vc * den)));
+}
+
+/* A sphere or capsule pressed into a hillside of many triangles (the
+ * terrain bench's hills, 0.25 m cells): the deepest point of its manifolds
+ * is as deep as the core's true overlap with the surface, r minus the
+ * core's distance from the nearest triangle (brute force over every
+ * triangle, the core sampled every 1 mm). A capsule's manifold keeps two
+ * points on its line; the end of its core over one triangle is also a
+ * shallow point beside the next one, and keeping that one (the farther
+ * along the line by a millimetre) left out a point 0.020 m deep: the
+ * capsule sank 0.028 m into the terrain. */
+static void test_composite_keeps_deepest_point(void **state)
+{
+    (void)state;
+    enum { N = 12 };
+    double v[3 * (N + 1) * (N + 1)];
+    int t[6 * N * N];
+    const double cell = 0.25, x0 = -7.0, y0 = 2.5;
+    for (int j = 0; j <= N; j++)
+        for (int i = 0; i <= N; i++) {
+            double x = x0 + i * cell, y = y0 + j * cell, *p = v + 3 * (j * (N + 1) + i);
+            p[0] = x; p[1] = y;
+            p[2] = 1.2 * sin(0.21 * x) * cos(0.17 * y) + 0.4 * sin(0.05 * x + 0.3) + 0.03 * sin(9 * x) * cos(7 * y);
+        }
+    int k = 0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++) {
+            int a = j * (N + 1) + i, b = a + 1, c = a + N + 2, d = a + N + 1;
+            int q[6] = {a, b, c, a, c, d};
+            for (int m = 0; m < 6; m++) t[k + m] = q[m];
+            k += 6;
+        }
+    char err[128];
+    tri_mesh *tm = mesh_build(v, (N + 1) * (N + 1), t, 2 * N * N, 0, err, sizeof err);
+    assert_non_null(tm);
+    shape ms;
+    memset(&ms, 0, sizeof ms);
+    ms.type = SHAPE_MESH;
+    ms.mesh = tm;
+    xform xm = {v3(0, 0, 0), q_identity()};
+    unsigned seed = 11;
+    double worst = 0;
+    int checked = 0;
+    for (int ti = 0; ti < 2; ti++) {
+        shape s = make_shape(ti == 0 ? SHAPE_SPHERE : SHAPE_CAPSULE);
+        s.radius = 0.15;
+        s.half_height = 0.2;
+        for (int trial = 0; trial < 300; trial++) {
+            double x = x0 + 0.8 + (N * cell - 1.6) * lcg(&seed), y = y0 + 0.8 + (N * cell - 1.6) * lcg(&seed);
+            /* lying nearly along the slope: tilted up to 0.3 rad out of the horizontal */
+            double yaw = 6.283185307179586 * lcg(&seed), tilt = 0.6 * lcg(&seed) - 0.3;
+            quat qy = {cos(0.5 * yaw), 0, 0, sin(0.5 * yaw)}, qt = {cos(0.25 * 3.141592653589793 + 0.5 * tilt), sin(0.25 * 3.141592653589793 + 0.5 * tilt), 0, 0};
+            xform xs = {v3(x, y, 0), q_mul(qy, qt)};
+            vec3 c0 = xs.p, c1 = xs.p;
+            /* lift the core until its distance from the surface is r minus
+             * the wanted overlap (a few secant steps on the brute force) */
+            double want = 0.03 * lcg(&seed), dist = 0;
+            xs.p.z = 1.2 * sin(0.21 * x) * cos(0.17 * y) + 0.4 * sin(0.05 * x + 0.3) + s.radius;
+            for (int it = 0; it < 4; it++) {
+                c0 = c1 = xs.p;
+                if (s.type == SHAPE_CAPSULE) capsule_segment(&s, xs, &c0, &c1);
+                dist = 1e300;
+                for (int m = 0; m <= 400; m++) {
+                    vec3 c = v3_lerp(c0, c1, m / 400.0);
+                    for (int f = 0; f < 2 * N * N; f++) {
+                        const double *p0 = v + 3 * t[3 * f], *p1 = v + 3 * t[3 * f + 1], *p2 = v + 3 * t[3 * f + 2];
+                        if (fabs(p0[0] - c.x) > 0.6 || fabs(p0[1] - c.y) > 0.6) continue; /* far: not the nearest */
+                        vec3 tri[3] = {{p0[0], p0[1], p0[2]}, {p1[0], p1[1], p1[2]}, {p2[0], p2[1], p2[2]}};
+                        double d2 = v3_len2(v3_sub(c, closest_on_triangle(c, tri)));
+                        if (d2 < dist) dist = d2;
+                    }
+                    if (s.type == SHAPE_SPHERE) break;
+                }
+                dist = sqrt(dist);
+                if (it < 3) xs.p.z += s.radius - want - dist;
+            }
+            manifold out[COMPOSITE_MAX_MANIFOLDS];
+            int n = collide_composite(&ms, xm, &s, xs, 0.02, out, COMPOSITE_MAX_MANIFOLDS);
+            double deepest = 1e300;
+            for (int g = 0; g < n; g++)
+                for (int i = 0; i < out[g].count; i++) deepest = fmin(deepest, out[g].points[i].separation);
+            double overlap = s.radius - dist; /* the true depth */
+            double room = deepest + overlap;  /* room claimed beyond the truth */
+            if (room > 1e-5) printf("  type %d trial %d: deepest point %.4f m, true overlap %.4f m\n", s.type, trial, deepest, overlap);
+            worst = fmax(worst, room);
+            checked++;
+        }
+        shape_free_data(&s);
+    }
+    printf("  %d poses: most room claimed beyond the true overlap %.2g m\n", checked, worst);
+    assert_true(worst <= 1e-5); /* the brute force samples the core every 1 mm */
+    mesh_free(tm);
 }
 
 /* A sphere or capsule against many triangles: every point of every manifold
@@ -953,6 +1081,7 @@ int main(void)
         cmocka_unit_test(test_outline_reduction_keeps_corners),
         cmocka_unit_test(test_seam_pass_judges_locally),
         cmocka_unit_test(test_core_points_on_the_normal_line),
+        cmocka_unit_test(test_composite_keeps_deepest_point),
         cmocka_unit_test(test_incline_analytic),
         cmocka_unit_test(test_cylinder_rolls_on_incline),
         cmocka_unit_test(test_cylinder_rolls_like_plane),
