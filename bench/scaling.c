@@ -6,6 +6,9 @@
  *     sizes). CSV: bodies,ms_step,contacts.
  *   scaling switches SWITCH [PLANAR [TIMED]]
  *     resting boxes with one switch off (see run_switches).
+ *   scaling switch-table PLANAR [ROUNDS [STEPS]]
+ *     every switch of that scene, timed in interleaved rounds (101 of 4
+ *     steps; see run_switch_table).
  *   scaling pyramids N [WORKERS [PRESET [TIMED]]]
  *     one row of the peers' pyramid grid (peers/scenes.h pyramidsN: base-10
  *     pyramids, 55 boxes each, mu 0.6, sleeping off): 30 untimed steps, then
@@ -86,6 +89,14 @@ static double cpu_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
+/* This thread's CPU time: the step's own cost, whatever else the machine runs. */
+static double thread_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
 /* A world of the grid on `workers` workers, every body added; one step timed
  * (the first) when first_ms is not NULL. clamp: one box starts at the speed
  * clamp, thrown over the grid. */
@@ -151,9 +162,11 @@ static int run_pyramids(int n, int workers, const char *preset, int timed)
 /* The switches' scene: a 32 x 32 grid of separated unit boxes each resting
  * on the ground (2 m apart, sleeping off), the motion the same with every
  * switch; `planar`: the same grid locked to the x-z plane. One switch off
- * per run (`none`: all on). Settles 60 steps, then times `timed`. Prints
- * switch,planar,ms_step,cpu_ms_step. */
-static int run_switches(const char *which, int planar, int timed)
+ * per world (`none`: all on), settled 60 steps. */
+static const char *const switch_names[] = {"none", "friction", "restitution", "rotation", "ccd", "none"};
+#define SWITCHES 6 /* the last: all on again (run_switch_table's noise floor) */
+
+static carom_world *switch_world(const char *which, int planar)
 {
     carom_world_def wd = carom_world_def_default();
     wd.enable_sleep = 0;
@@ -162,7 +175,7 @@ static int run_switches(const char *which, int planar, int timed)
     else if (!strcmp(which, "restitution")) wd.enable_restitution = 0;
     else if (!strcmp(which, "ccd")) wd.enable_continuous = 0;
     else if (!strcmp(which, "rotation")) lock_rotation = 1;
-    else if (strcmp(which, "none")) return 2;
+    else if (strcmp(which, "none")) return NULL;
     carom_world *w = carom_world_create(&wd);
     carom_body_def g = carom_body_def_default();
     g.type = CAROM_BODY_STATIC;
@@ -180,6 +193,15 @@ static int run_switches(const char *which, int planar, int timed)
         carom_body_create(w, &d);
     }
     for (int s = 0; s < 60; s++) carom_world_step(w, 1.0 / 60);
+    return w;
+}
+
+/* One switch, timed alone (a profiling driver): `timed` steps after the
+ * settle. Prints switch,planar,ms_step,cpu_ms_step. */
+static int run_switches(const char *which, int planar, int timed)
+{
+    carom_world *w = switch_world(which, planar);
+    if (!w) return 2;
     double *ms = malloc(sizeof *ms * (size_t)timed);
     double cpu0 = cpu_ms();
     for (int s = 0; s < timed; s++) {
@@ -195,8 +217,68 @@ static int run_switches(const char *which, int planar, int timed)
     return 0;
 }
 
+/* The switches' table: the five worlds (all on and each switch off) and a
+ * second all-on world side by side in one process, timed in `rounds` interleaved rounds: in each, every
+ * world steps once untimed (its data back in the caches after the others
+ * ran) and then `steps` timed steps, the worlds in an order rotated by one
+ * each round, so that a slow spell of the machine (other processes, clock
+ * changes) falls on every switch alike instead of on whichever one ran
+ * then. Printed: the medians over the rounds of the wall and the CPU time
+ * per step (this thread's: what the step itself costs), and the median of
+ * each round's CPU time over all on's in the same round (a paired ratio: a
+ * slow spell that spans a round cancels) with its 95 % interval (the
+ * order statistics n/2 -+ 0.98 sqrt(n) of the n rounds' ratios: a switch
+ * reads slower only when the whole interval lies above 1; a switch whose
+ * removed work is below the machine's noise reads "the same"). The second
+ * all-on world ("again") does the same work as the first: its ratio and
+ * interval are the noise floor of the run, measured rather than assumed
+ * (on the loaded 2-core machine the order-statistics interval alone was too
+ * narrow: runs' medians moved by +-1.5 %). A single timing of each switch
+ * after the other read restitution off and ccd off 0.7 and 1 % slower than
+ * all on (make bench, main 762a48d), work they remove being 0.14 and 1.6 %
+ * of the step. Prints switch,planar,ms_step,cpu_ms_step,cpu_vs_on,
+ * cpu_vs_on_lo,cpu_vs_on_hi, one line a switch. */
+static int run_switch_table(int planar, int rounds, int steps)
+{
+    carom_world *w[SWITCHES];
+    size_t n = (size_t)rounds * SWITCHES;
+    double *ms = malloc(sizeof *ms * n), *cpu = malloc(sizeof *cpu * n), *ratio = malloc(sizeof *ratio * n);
+    if (!ms || !cpu || !ratio) return 2;
+    for (int k = 0; k < SWITCHES; k++) w[k] = switch_world(switch_names[k], planar);
+    for (int r = 0; r < rounds; r++)
+        for (int i = 0; i < SWITCHES; i++) {
+            int k = (i + r) % SWITCHES;
+            carom_world_step(w[k], 1.0 / 60);
+            double t0 = bench_now_ms(), c0 = thread_cpu_ms();
+            for (int s = 0; s < steps; s++) carom_world_step(w[k], 1.0 / 60);
+            cpu[k * rounds + r] = (thread_cpu_ms() - c0) / steps;
+            ms[k * rounds + r] = (bench_now_ms() - t0) / steps;
+        }
+    for (int k = 0; k < SWITCHES; k++)
+        for (int r = 0; r < rounds; r++) ratio[k * rounds + r] = cpu[k * rounds + r] / cpu[r];
+    for (int k = 0; k < SWITCHES; k++) {
+        qsort(ms + k * rounds, (size_t)rounds, sizeof *ms, cmp);
+        qsort(cpu + k * rounds, (size_t)rounds, sizeof *cpu, cmp);
+        qsort(ratio + k * rounds, (size_t)rounds, sizeof *ratio, cmp);
+        int m = k * rounds + rounds / 2, half = (int)ceil(0.98 * sqrt((double)rounds));
+        int lo = rounds / 2 - half < 0 ? 0 : rounds / 2 - half, hi = rounds / 2 + half >= rounds ? rounds - 1 : rounds / 2 + half;
+        printf("%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f\n", k == SWITCHES - 1 ? "again" : switch_names[k], planar, ms[m], cpu[m], ratio[m],
+               ratio[k * rounds + lo], ratio[k * rounds + hi]);
+        carom_world_destroy(w[k]);
+    }
+    free(ms);
+    free(cpu);
+    free(ratio);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "switch-table") == 0) {
+        int rounds = argc > 3 ? atoi(argv[3]) : 101, steps = argc > 4 ? atoi(argv[4]) : 4;
+        if (rounds < 1 || steps < 1) return 2;
+        return run_switch_table(atoi(argv[2]) != 0, rounds, steps);
+    }
     if (argc > 2 && strcmp(argv[1], "switches") == 0)
         return run_switches(argv[2], argc > 3 && atoi(argv[3]), argc > 4 ? atoi(argv[4]) : 120);
     if (argc > 2 && strcmp(argv[1], "first") == 0) { /* profiling: build the grid, one step */

@@ -13,8 +13,13 @@
 # Bounded for make bench: 30 untimed steps, then TIMED (60) timed ones (the
 # median is printed), 30 at 49,995 bodies; fast and accurate skip 49,995.
 # Then the switches' table: 1,024 separated boxes resting on the ground (and
-# the same locked to the x-z plane), each switch off in turn: ms/step and
-# CPU ms/step beside all on (OUT minus .csv plus _switches.csv).
+# the same locked to the x-z plane), all on and each switch off side by side
+# in one process with a second all-on world (its ratio is the run's noise
+# floor), timed in 101 interleaved rounds: median ms/step, CPU ms/step and
+# the median of the paired per-round CPU ratio to all on with its 95 %
+# interval; a switch reads slower (faster) only when its interval lies above
+# (below) 1 and the second all-on world's (OUT minus .csv plus
+# _switches.csv; scaling.c's run_switch_table).
 set -eu
 cd "$(dirname "$0")"
 out=${1:-../build/bench/out/pyramids.csv}
@@ -72,10 +77,21 @@ awk -F, 'NR > 1 && $1 == "carom" && $2 == "default" && $3 == 1 { n[++k] = $4; us
     }' "$out"
 
 sw=${out%.csv}_switches.csv
-echo "switch,planar,ms_step,cpu_ms_step" > "$sw"
-for planar in 0 1; do
-    for s in none friction restitution rotation ccd; do $bin switches "$s" "$planar" 120 >> "$sw"; done
-done
-awk -F, 'NR > 1 { if ($1 == "none") { on[$2] = $3; cpu[$2] = $4 }
-                  printf "switches: %-16s %s  %8.3f ms/step (x%.3f of all on)  cpu %8.3f ms (x%.3f)\n", $1 == "none" ? "all on" : $1 == "rotation" ? "rotation locked" : $1 " off",
-                         $2 ? "planar" : "3D    ", $3, $3 / on[$2], $4, $4 / cpu[$2] }' "$sw"
+echo "switch,planar,ms_step,cpu_ms_step,cpu_vs_on,cpu_vs_on_lo,cpu_vs_on_hi" > "$sw"
+for planar in 0 1; do $bin switch-table "$planar" >> "$sw"; done
+awk -F, 'NR > 1 { n++; name[n] = $1; pl[n] = $2; ms[n] = $3; cpu[n] = $4; r[n] = $5; lo[n] = $6; hi[n] = $7
+                  if ($1 == "none") on[$2] = $3
+                  if ($1 == "again") { aa_lo[$2] = $6; aa[$2] = $7 } }
+         END {
+             for (i = 1; i <= n; i++) {
+                 s = name[i]; p = pl[i]
+                 # slower: the whole interval above 1 and above that of the second all-on world (the noise floor)
+                 bad = s != "none" && s != "again" && lo[i] > 1 && lo[i] > aa[p]
+                 verdict = s == "none" ? "" : s == "again" ? "  (noise floor: the same work)" : bad ? "  SLOWER" : hi[i] < 1 && hi[i] < aa_lo[p] ? "  faster" : "  the same within the noise"
+                 if (bad) slower = slower " " s (p ? " (planar)" : "")
+                 printf "switches: %-16s %s  %8.3f ms/step (x%.3f of all on)  cpu %8.3f ms, x%.4f of all on (95 %%: %.4f-%.4f)%s\n",
+                        s == "none" ? "all on" : s == "again" ? "all on again" : s == "rotation" ? "rotation locked" : s " off",
+                        p ? "planar" : "3D    ", ms[i], ms[i] / on[p], cpu[i], r[i], lo[i], hi[i], verdict
+             }
+             print slower == "" ? "switches: no switch off is slower than all on" : "switches: slower than all on:" slower
+         }' "$sw"
