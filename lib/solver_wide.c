@@ -56,13 +56,13 @@ typedef struct wide_point {
 } wide_point;
 
 /* The compact point of a large world's batches (wide_plan: at least
- * WIDE_COMPACT_POINTS points), 112 bytes a point instead of 352: the
- * anchors in the batch's contact basis (n, t1, t2) instead of the nine arms
+ * WIDE_COMPACT_POINTS points), 88 bytes a point instead of 352: a's
+ * anchor in the batch's contact basis (n, t1, t2) instead of the nine arms
  * and their nine responses through the inertias. In that basis an arm
  * r x e is three coordinates of r, and the inertias' responses come from
  * the batch's two basis-projected inverse inertias (wide_inertia), so every
- * row is recomputed in each pass, in double, from 14 lanes a point and 12 a
- * manifold. The same rows as wide_point's, to rounding; the velocities are
+ * row is recomputed in each pass, in double, from 11 lanes a point and 15 a
+ * manifold (b's anchor from a's and the centres' offset). The same rows as wide_point's, to rounding; the velocities are
  * solved in the basis too (wide normal and friction rows then read one or
  * two coordinates), turned into it when a batch is gathered and back when
  * it is scattered. A small world's rows fit the caches and the precomputed
@@ -72,7 +72,8 @@ typedef struct wide_cpoint {
     lane_t base_separation, normal_mass, normal_impulse;
     lane_t total_normal_impulse;
     lane_t tangent_mass[2], tangent_impulse[2];
-    lane_t ra[3], rb[3];         /* anchors from each centre, in the basis: (r.n, r.t1, r.t2) */
+    lane_t ra[3];                /* anchor from a's centre, in the basis: (r.n, r.t1, r.t2); b's is
+                                    ra - d (wide_inertia: both arms reach the same point) */
 } wide_cpoint;
 
 /* The point of a batch whose bodies cannot turn (each static or
@@ -110,9 +111,13 @@ typedef struct wide_plane {
 } wide_plane;
 
 /* A compact batch's inverse inertias in its basis e = (n, t1, t2), e_i.I^-1 e_j:
- * the upper triangle 00 01 02 11 12 22. */
+ * the upper triangle 00 01 02 11 12 22; and b's centre less a's in the
+ * basis, d: both arms reach the same contact point, rb = ra - d, so a point
+ * keeps one anchor (3 lanes) and the batch these 3 (at 4 points a manifold,
+ * 72 bytes a manifold less; the same rows to rounding). */
 typedef struct wide_inertia {
     lane_t ka[6], kb[6];
+    lane_t d[3];
 } wide_inertia;
 
 /* Points from here on a batch take the compact rows (wide_cpoint): 16,384
@@ -1401,6 +1406,12 @@ LANE_INLINE double prepare_batch_p(const wide_batch *wb, wide_plane *pl, wide_pp
         (dst)[2] = DOT3((wb_)->t2, src);        \
     } while (0)
 
+/* b's anchor in the basis from a's (wide_inertia's d) */
+#define ARM_B(rb_, ra_, d_)                                     \
+    do {                                                        \
+        for (int k_ = 0; k_ < 3; k_++) (rb_)[k_] = (ra_)[k_] - (d_)[k_]; \
+    } while (0)
+
 /* The lanes' bodies as gathered (world) and in the basis, solved there. */
 typedef struct lane_cbodies {
     lane_bodies world;
@@ -1461,6 +1472,8 @@ LANE_INLINE void warm_batch_c(const wide_batch *wb, const wide_inertia *in, wide
     for (int i = 0; i < wb->count; i++) {
         wide_cpoint *p = &pts[i];
         lane_t ni = p->normal_impulse, t1 = p->tangent_impulse[0], t2 = p->tangent_impulse[1];
+        lane_t rb[3];
+        ARM_B(rb, p->ra, in->d);
         p->total_normal_impulse += ni;
         lb.va[0] -= lb.ma * ni;
         lb.vb[0] += lb.mb * ni;
@@ -1470,10 +1483,10 @@ LANE_INLINE void warm_batch_c(const wide_batch *wb, const wide_inertia *in, wide
             lb.vb[1] += lb.mb * t1;
             lb.vb[2] += lb.mb * t2;
             PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, t1, t2);
-            PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, t1, t2);
+            PUSH_ANGULAR(lb.wb, +, in->kb, rb, ni, t1, t2);
         } else {
             PUSH_ANGULAR(lb.wa, -, in->ka, p->ra, ni, zero, zero);
-            PUSH_ANGULAR(lb.wb, +, in->kb, p->rb, ni, zero, zero);
+            PUSH_ANGULAR(lb.wb, +, in->kb, rb, ni, zero, zero);
         }
         if (locked) {
             KEEP_IN_PLANE(lb.va, lk->a);
@@ -1503,7 +1516,9 @@ LANE_INLINE void solve_normal_rows_c(const wide_batch *wb, const wide_inertia *i
     const lane_t baum_rate = SPLAT(ctx->baumgarte_rate), slop = SPLAT(ctx->slop);
     for (int i = 0; i < wb->count; i++) {
         wide_cpoint *p = &pts[i];
-        const lane_t *a = p->ra, *b = p->rb;
+        const lane_t *a = p->ra;
+        lane_t b[3];
+        ARM_B(b, a, in->d);
         lane_t s = p->base_separation + dpn + (b[2] * qb1 - b[1] * qb2) - (a[2] * qa1 - a[1] * qa2);
         lane_t pen_bias = zero;
         if (soft || baumgarte) {
@@ -1544,7 +1559,9 @@ LANE_INLINE void solve_friction_rows_c(const wide_batch *wb, const wide_inertia 
     const lane_t zero = SPLAT(0.0);
     for (int i = 0; i < wb->count; i++) {
         wide_cpoint *p = &pts[i];
-        const lane_t *a = p->ra, *b = p->rb;
+        const lane_t *a = p->ra;
+        lane_t b[3];
+        ARM_B(b, a, in->d);
         lane_t v1 = (lb->vb[1] - lb->va[1]) + (b[0] * lb->wb[2] - b[2] * lb->wb[0]) -
                     (a[0] * lb->wa[2] - a[2] * lb->wa[0]);
         lane_t v2 = (lb->vb[2] - lb->va[2]) + (b[1] * lb->wb[0] - b[0] * lb->wb[1]) -
@@ -1607,6 +1624,9 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
     gather_manifolds(wb, cc, bodies, &lm, 1);
     project_inertia(in->ka, wb, lm.ia);
     project_inertia(in->kb, wb, lm.ib);
+    lane_t dc[3];
+    for (int d = 0; d < 3; d++) dc[d] = lm.center_b[d] - lm.center_a[d];
+    TO_BASIS(in->d, wb, dc);
     /* the linear share of each row's inverse effective mass (n, t1, t2);
      * a locked body's plane normal is in the basis here */
     lane_t lin[3];
@@ -1622,8 +1642,9 @@ LANE_INLINE double prepare_batch_c(const wide_batch *wb, wide_inertia *in, wide_
         lane_t ra[3], rb[3], sep;
         gather_point(&lm, i, st, ra, rb, &sep);
         TO_BASIS(p->ra, wb, ra);
-        TO_BASIS(p->rb, wb, rb);
-        const lane_t *a = p->ra, *b = p->rb;
+        const lane_t *a = p->ra;
+        lane_t b[3];
+        ARM_B(b, a, in->d);
         /* the arms r x n, r x t1, r x t2 in the basis, and their masses */
         lane_t jan[3] = {zero, a[2], -a[1]}, jbn[3] = {zero, b[2], -b[1]};
         lane_t ja1[3] = {-a[2], zero, a[0]}, jb1[3] = {-b[2], zero, b[0]};
