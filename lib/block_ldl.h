@@ -8,20 +8,6 @@
 #define BLOCK_INLINE static inline __attribute__((always_inline))
 #else
 #define BLOCK_INLINE static inline
-/* block_apply_n for 4 rows (faces, the common case) spelled out: GCC at
- * -O2 left the loops rolled. */
-BLOCK_INLINE void block_apply4(double L[4][4], const double r[4], double x[4])
-{
-    double y0 = r[0];
-    double y1 = r[1] - L[1][0] * y0;
-    double y2 = r[2] - L[2][0] * y0 - L[2][1] * y1;
-    double y3 = r[3] - L[3][0] * y0 - L[3][1] * y1 - L[3][2] * y2;
-    x[3] = y3 * L[3][3];
-    x[2] = y2 * L[2][2] - L[3][2] * x[3];
-    x[1] = y1 * L[1][1] - L[2][1] * x[2] - L[3][1] * x[3];
-    x[0] = y0 * L[0][0] - L[1][0] * x[1] - L[2][0] * x[2] - L[3][0] * x[3];
-}
-
 #endif
 
 /* The compliance added to every row of a block, times the row's own K_ii:
