@@ -26,7 +26,10 @@
 #include "snapshot.h"
 
 #define SNAP_MAGIC "CAROMSNP"
-#define SNAP_VERSION 7u
+#define SNAP_VERSION 8u
+/* The oldest format the reader still takes: 7 differs only in how a
+ * contact names its two bodies (docs/snapshot.md, "Format 7"). */
+#define SNAP_VERSION_OLDEST 7u
 #define SNAP_HEADER_SIZE 32u
 
 /* ---- writer: little-endian whatever the host ----------------------------------- */
@@ -110,6 +113,7 @@ typedef struct reader {
     char *msg;
     size_t msg_size;
     int failed;
+    unsigned version;       /* the snapshot's format (SNAP_VERSION_OLDEST .. SNAP_VERSION) */
 } reader;
 
 /* The reader's pose checks: a quaternion more than 1e-6 from unit length, and
@@ -1295,13 +1299,15 @@ static void point_guess(const reuse_motion *m, const contact_data *d, xform xa, 
 /* contact record bits, after the point count (3 bits); a contact's head
  * varint is its flags (6 bits) | bits << 6, so a touching manifold's usual
  * record (count, feature, exact points, cache normal, basis as predicted,
- * flip) fits its first 14 bits: two bytes. CREC_B_FIRST: the pair's body A
- * (the solve's first, collision.c) is the higher id of the two written;
- * without it the lower (as every contact was before the rank rule). */
+ * flip) fits its first 14 bits: two bytes. CREC_B_FIRST (format 7 only):
+ * the pair's body A (the solve's first, collision.c) is the higher id of
+ * the two written, without it the lower; format 8 writes A's id first and
+ * has no such bit (it cost a settled pile's idle pairs 3 bytes each: their
+ * head grew from one byte to four). */
 enum { CREC_FEATURE = 8, CREC_EXACT = 16, CREC_HAS_NORMAL = 32, CREC_TANGENT_GUESS = 64, CREC_FLIP = 128,
        CREC_NORMAL = 256, CREC_SUB = 512, CREC_SUB_LIMIT = 1024, CREC_TANGENT = 2048, CREC_CACHE_NORMAL = 4096,
-       CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_B_FIRST = 131072,
-       CREC_ALL = 262143 };
+       CREC_MATERIAL = 8192, CREC_POSE = 16384, CREC_REACH = 32768, CREC_NORMAL_A = 65536, CREC_ALL = 131071,
+       CREC_B_FIRST = 131072, CREC_ALL_7 = 262143 };
 #define CONTACT_FLAG_BITS 6
 /* The flags under which a pair's record has more than its ids, head and
  * cache feature (its data is read, or it is posed) */
@@ -1406,8 +1412,16 @@ SNAP_INLINE unsigned contact_bits(const contact *c, const contact_data *d, conta
                         (posed && !(same_bits(&c->rel_pose.p, &rel->p, sizeof rel->p) && same_bits(&c->rel_pose.q, &rel->q, sizeof rel->q))
                              ? CREC_POSE : 0) |
                         ((c->flags & CONTACT_APART) && f64_bits(c->reach_b) != f64_bits(reach) ? CREC_REACH : 0) |
-                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, normal_a, sizeof *normal_a) ? CREC_NORMAL_A : 0) |
-                        (c->id_a > c->id_b ? CREC_B_FIRST : 0);
+                        ((c->flags & CONTACT_REUSABLE) && !same_bits(&d->normal_a, normal_a, sizeof *normal_a) ? CREC_NORMAL_A : 0);
+}
+
+/* A contact's two bodies: zvar A's id less the previous contact's A, then
+ * var zigzag(B's id - A's id) - 1 (B is never A). */
+SNAP_INLINE void put_pair(writer *o, const contact *c, int *last_a)
+{
+    put_varint(o, zigzag((int64_t)c->id_a - *last_a));
+    put_varint(o, zigzag((int64_t)c->id_b - c->id_a) - 1);
+    *last_a = c->id_a;
 }
 
 static void write_contacts(writer *o, const carom_world *w, const class_table *t)
@@ -1422,6 +1436,9 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
     int last_a = 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
+        /* the pair as body A, then B (the cache holds new pairs in rank
+         * order, so A's ids follow one another closely: 2.5 % fewer id
+         * bytes on a settled pile than the lower id first) */
         const contact_data *d = CONTACT_DATA(cs, i);
         if (!c->slot && !(c->flags & IDLE_RECORD_FLAGS) && !c->sub && !c->sub_limit && v3_is_zero(c->cache.normal)) {
             /* a broadphase pair without data (most of a settled pile's):
@@ -1430,11 +1447,8 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
              * basis or material; not posed) */
             size_t at = o->pos;
             unsigned bits = (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
-                            (c->cache.feature != -1 ? CREC_FEATURE : 0) | (c->id_a > c->id_b ? CREC_B_FIRST : 0);
-            int lo = c->id_a < c->id_b ? c->id_a : c->id_b, hi = c->id_a < c->id_b ? c->id_b : c->id_a;
-            put_varint(o, zigzag((int64_t)lo - last_a));
-            put_varint(o, (uint64_t)(hi - lo - 1));
-            last_a = lo;
+                            (c->cache.feature != -1 ? CREC_FEATURE : 0);
+            put_pair(o, c, &last_a);
             put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
             if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
             acct(o, SNAP_FIELD_contact_header, at);
@@ -1465,10 +1479,7 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
         }
         if (exact) bits |= CREC_EXACT;
         size_t at = o->pos;
-        int lo = c->id_a < c->id_b ? c->id_a : c->id_b, hi = c->id_a < c->id_b ? c->id_b : c->id_a;
-        put_varint(o, zigzag((int64_t)lo - last_a));
-        put_varint(o, (uint64_t)(hi - lo - 1));
-        last_a = lo;
+        put_pair(o, c, &last_a);
         put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
         if (bits & CREC_SUB) put_varint(o, c->sub);
         if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
@@ -2034,16 +2045,28 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
     contact_data scratch_data; /* (a slotless pair's record: see below) */
     memset(&scratch_data, 0, sizeof scratch_data);
     contact_data *scratch = &scratch_data;
-    int last_a = 0;
+    int last_a = 0, old = r->version == 7; /* format 7: the lower id first, then bit CREC_B_FIRST */
+    int64_t all_bits = old ? CREC_ALL_7 : CREC_ALL;
     for (int i = 0; i < count && !r->failed; i++) {
-        int a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 2 - last_a, 1, "contact body");
-        if (r->failed) return 0;
-        int b = a + 1 + get_small(r, 0, (int64_t)s->id_count - 2 - a, 0, "contact body");
+        int a, b;
+        if (old) {
+            a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 2 - last_a, 1, "contact body");
+            if (r->failed) return 0;
+            b = a + 1 + get_small(r, 0, (int64_t)s->id_count - 2 - a, 0, "contact body");
+        } else { /* body A's id, then B's from it (never A's) */
+            a = last_a + get_small(r, -(int64_t)last_a, (int64_t)s->id_count - 1 - last_a, 1, "contact body A");
+            if (r->failed) return 0;
+            int64_t d = unzigzag((uint64_t)get_small(r, 0, 2 * (int64_t)s->id_count, 0, "contact body B") + 1);
+            if (r->failed) return 0;
+            if (a + d < 0 || a + d >= s->id_count)
+                return bad(r, "contact %d: body B %lld is outside the id table [0, %d)", i, (long long)(a + d), s->id_count);
+            b = (int)(a + d);
+        }
         if (r->failed) return 0;
         last_a = a;
         if (s->ids[a].slot < 0 || s->ids[b].slot < 0)
             return bad(r, "contact %d joins ids %d and %d, not two live bodies", i, a, b);
-        int head = get_small(r, 0, ((int64_t)CREC_ALL << CONTACT_FLAG_BITS) | ((1 << CONTACT_FLAG_BITS) - 1), 0, "contact flags");
+        int head = get_small(r, 0, (all_bits << CONTACT_FLAG_BITS) | ((1 << CONTACT_FLAG_BITS) - 1), 0, "contact flags");
         uint32_t flags = (uint32_t)head & ((1u << CONTACT_FLAG_BITS) - 1);
         int bits = head >> CONTACT_FLAG_BITS;
         uint32_t sub = (bits & CREC_SUB) ? (uint32_t)get_small(r, 1, 1000000, 0, "contact sub") : 0;
@@ -2055,9 +2078,14 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
             ((bits & CREC_POSE) && !posed) || ((bits & CREC_REACH) && !(flags & CONTACT_APART)) ||
             ((bits & CREC_NORMAL_A) && !(flags & CONTACT_REUSABLE)))
             return bad(r, "contact %d has unknown flags, too many points or fields its flags do not use", i);
-        if (bits & CREC_B_FIRST) { int t = a; a = b; b = t; } /* body A first */
+        if (bits & CREC_B_FIRST) { /* (format 7) body A first */
+            int t = a;
+            a = b;
+            b = t;
+            bits &= ~CREC_B_FIRST;
+        }
         int ci = contact_append(cs, a, b, sub); /* (the pair map is built after the last, contact_set_index) */
-        if (ci >= 0 && !(flags & IDLE_RECORD_FLAGS) && !(bits & ~(CREC_HAS_NORMAL | CREC_FLIP | CREC_FEATURE | CREC_B_FIRST))) {
+        if (ci >= 0 && !(flags & IDLE_RECORD_FLAGS) && !(bits & ~(CREC_HAS_NORMAL | CREC_FLIP | CREC_FEATURE))) {
             /* a pair without data, not posed, of the first manifold (the
              * writer's short record): nothing more to read, and what the
              * general path below would check holds (its bits are its cache's) */
@@ -2180,7 +2208,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
 
 CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *msg, size_t msg_size)
 {
-    reader r = {data, size, 0, msg, msg_size, 0};
+    reader r = {data, size, 0, msg, msg_size, 0, SNAP_VERSION};
     if (msg && msg_size) msg[0] = '\0';
     if (!data) return bad(&r, "data is NULL"), NULL;
     if (size < SNAP_HEADER_SIZE || memcmp(data, SNAP_MAGIC, 8) != 0)
@@ -2188,8 +2216,9 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     r.pos = 8;
     uint32_t version = get_u32(&r, "version"), header = get_u32(&r, "header size");
     uint64_t total = get_u64(&r, "size"), sum = get_u64(&r, "checksum");
-    if (version != SNAP_VERSION)
-        return bad(&r, "version %u; this carom reads version %u", (unsigned)version, SNAP_VERSION), NULL;
+    if (version < SNAP_VERSION_OLDEST || version > SNAP_VERSION)
+        return bad(&r, "version %u; this carom reads versions %u to %u", (unsigned)version, SNAP_VERSION_OLDEST, SNAP_VERSION), NULL;
+    r.version = version;
     if (header != SNAP_HEADER_SIZE) return bad(&r, "header size %u, expected %u", (unsigned)header, SNAP_HEADER_SIZE), NULL;
     if (total != size)
         return bad(&r, "truncated or padded: the header says %llu bytes, %zu given", (unsigned long long)total, size), NULL;

@@ -447,8 +447,9 @@ static void test_wake_any_order(void **state)
     assert_int_equal(compare_orders(&s, "wake"), 0);
 }
 
-/* A snapshot keeps which body of each pair is A (docs/snapshot.md: record
- * bit 131072): the mixed scene built in reverse, so that many pairs' A is
+/* A snapshot keeps which body of each pair is A (docs/snapshot.md: A's id
+ * is written first in each contact record; format 7 had record bit
+ * 131072): the mixed scene built in reverse, so that many pairs' A is
  * the higher id, snapshot after 60 steps, restored, and both worlds stepped
  * 120 more: the same snapshot after every step. */
 static void test_snapshot_keeps_body_a(void **state)

@@ -109,7 +109,7 @@ test("bad snapshots raise a clear error", function()
   raises("truncated or padded", carom.restore, s .. "x")
   local flipped = s:sub(1, 200) .. string.char((s:byte(201) + 1) % 256) .. s:sub(202)
   raises("checksum", carom.restore, flipped)
-  raises("version 8", carom.restore, s:sub(1, 8) .. "\8" .. s:sub(10))
+  raises("version 9", carom.restore, s:sub(1, 8) .. "\9" .. s:sub(10))
 end)
 
 
