@@ -36,6 +36,39 @@ BLOCK_INLINE int block_factor_n(int n, double A[4][4], double L[4][4])
     return 1;
 }
 
+/* block_factor_n for 4 rows (faces, the common case) spelled out, the same
+ * arithmetic in the same order: GCC at -O2 left the loops rolled (the
+ * 10-box stack at default spent 2.5M of its 135.6M instructions in them,
+ * callgrind). */
+BLOCK_INLINE int block_factor4(double A[4][4], double L[4][4])
+{
+    double d0 = A[0][0];
+    if (!(d0 > 0.0)) return 0;
+    double l00 = L[0][0] = 1.0 / d0;
+    double u10 = A[1][0];
+    double l10 = L[1][0] = u10 * l00;
+    double d1 = A[1][1] - u10 * l10;
+    if (!(d1 > 0.0)) return 0;
+    double l11 = L[1][1] = 1.0 / d1;
+    double u20 = A[2][0];
+    double l20 = L[2][0] = u20 * l00;
+    double u21 = A[2][1] - u20 * l10;
+    double l21 = L[2][1] = u21 * l11;
+    double d2 = A[2][2] - u20 * l20 - u21 * l21;
+    if (!(d2 > 0.0)) return 0;
+    double l22 = L[2][2] = 1.0 / d2;
+    double u30 = A[3][0];
+    double l30 = L[3][0] = u30 * l00;
+    double u31 = A[3][1] - u30 * l10;
+    double l31 = L[3][1] = u31 * l11;
+    double u32 = A[3][2] - u30 * l20 - u31 * l21;
+    double l32 = L[3][2] = u32 * l22;
+    double d3 = A[3][3] - u30 * l30 - u31 * l31 - u32 * l32;
+    if (!(d3 > 0.0)) return 0;
+    L[3][3] = 1.0 / d3;
+    return 1;
+}
+
 /* x = A^-1 r from block_factor's L. */
 BLOCK_INLINE void block_apply_n(int n, double L[4][4], const double r[4], double x[4])
 {

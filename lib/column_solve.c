@@ -184,7 +184,7 @@ static int column_factor(column_link *link, int begin, int end, const step_conte
                     D[j][i] = D[i][j];
                 }
         }
-        if (!block_factor_n(4, D, l->S[kind])) return -1;
+        if (!block_factor4(D, l->S[kind])) return -1;
         if (k + 1 < end) {
             for (int j = 0; j < 4; j++) {
                 double col[4] = {l->B[0][j], l->B[1][j], l->B[2][j], l->B[3][j]}, x[4];

@@ -106,7 +106,7 @@ static int block_factor(int n, double A[4][4], double L[4][4])
     switch (n) {
     case 2: return block_factor_n(2, A, L);
     case 3: return block_factor_n(3, A, L);
-    default: return block_factor_n(4, A, L);
+    default: return block_factor4(A, L);
     }
 }
 
@@ -275,7 +275,7 @@ SOLVE_OUTLINE void block_make_factor(const contact_constraint *c, contact_block 
             for (int j = 0; j < 4; j++) A[i][j] = blk->K[i][j];
             A[i][i] += e * blk->K[i][i];
         }
-        blk->factored[soft] = block_factor_n(4, A, blk->inv[soft]) ? 1 : -1;
+        blk->factored[soft] = block_factor4(A, blk->inv[soft]) ? 1 : -1;
         return;
     }
     for (int i = 0; i < count; i++) {
