@@ -62,9 +62,11 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
 {
     m->count = 0;
     if (!ctx->blocks || ctx->penalty || scalar_count < 1) return 1;
-    /* no stiffer springs without relax passes (fast) or gravity
-     * (block_loaded_softness): the manifolds' own solves hold the setting's */
-    int stiffens = ctx->relax_iterations > 0 && ctx->warm_starting && ctx->gravity_length > 0.0;
+    /* no stiffer springs without gravity or warm starting
+     * (block_loaded_softness): the manifolds' own solves hold the setting's;
+     * without relax passes (fast) the columns' manifolds take one of their
+     * own (solver.c, relax_columns) */
+    int stiffens = ctx->warm_starting && ctx->gravity_length > 0.0;
     const contact_constraint *cc = ctx->constraints;
     int nb = ctx->body_count, ncon = ctx->constraint_count;
     for (int k = 0; k < scalar_count; k++) ctx->blocks[scalar ? scalar[k] : k].column = 0;
@@ -319,3 +321,7 @@ int column_solve_pass(column_memory *m, const step_context *ctx, int use_bias, i
     }
     return left;
 }
+
+int column_manifold_count(const column_memory *m) { return m->count > 0 ? ((const int *)m->start)[m->count] : 0; }
+
+int column_manifold(const column_memory *m, int i) { return ((const column_link *)m->links)[i].con; }

@@ -48,5 +48,9 @@ int column_prepare(column_memory *m, const step_context *ctx);
  * soft and rigid, or whose solution pulls, is left to them this pass.
  * Returns how many stiff manifolds were left so. */
 int column_solve_pass(column_memory *m, const step_context *ctx, int use_bias, int hold_bounces);
+/* The columns' manifolds, every column in turn: how many, and the
+ * constraint index of the i-th. */
+int column_manifold_count(const column_memory *m);
+int column_manifold(const column_memory *m, int i);
 
 #endif

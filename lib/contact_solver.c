@@ -201,15 +201,17 @@ static int block_lcp(int n, double A[4][4], const double b[4], double x[4], int 
  * did not hold even with five: leaned 2 cm to 1.7 m). Measured (top box, 10 s, dt 1/60, sag; default if
  * it were allowed there / accurate): the 20-tower 2.77 -> 0.76 cm / 0.69 ->
  * 0.19 cm, the 40-tower 11.05 -> 2.83 cm / 2.76 -> 0.71 cm. Only with relax passes, as
- * loaded_softness: at fast the stiffer spring set the 40-tower bouncing (up
- * 8.8 cm, fallen by 15 s). Returns 0 when the setting's softness stays (the
- * caller keeps c->soft). */
+ * loaded_softness (at fast the stiffer spring set the 40-tower bouncing, up
+ * 8.8 cm, fallen by 15 s), or in a column solved directly, whose manifolds
+ * take a relax pass of their own at fast (solver.c, relax_columns; the
+ * 20-tower at fast 10.63 -> 0.76 cm). Returns 0 when the setting's softness
+ * stays (the caller keeps c->soft). */
 #define BLOCK_STIFFENING_MAX 4.0
 static int block_loaded_softness(const contact_constraint *c, const step_context *ctx, double mA, double mB,
                                  int column, softness *out, int *stiff)
 {
     *stiff = 0;
-    if (!(ctx->relax_iterations > 0 && ctx->warm_starting && ctx->gravity_length > 0.0 && mA + mB > 0.0)) return 0;
+    if (!((ctx->relax_iterations > 0 || column) && ctx->warm_starting && ctx->gravity_length > 0.0 && mA + mB > 0.0)) return 0;
     if (c->soft.mass_scale == 1.0 && c->soft.impulse_scale == 0.0) return 0; /* held rigidly (touching impact) */
     double load = 0.0;
     for (int j = 0; j < c->count; j++) load += c->p[j].normal_impulse; /* last step's (warm starting on) */
