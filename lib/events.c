@@ -14,15 +14,23 @@ static int push_event(carom_world *w, const carom_contact_event *e, int contact_
      * until the next step), and a doubled buffer's unused half is resident
      * wherever the allocator hands out pages it used before */
     if (!array_reserve_near((void **)&b->items, &b->capacity, b->count + 1, sizeof *b->items)) return 0;
-    if (!array_reserve_near((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children)) return 0;
-    int *children = b->children[b->count];
-    children[0] = children[1] = -1;
+    int child[2] = {-1, -1};
+    if (contact_index >= 0) { /* from a contact (not a sensor) */
+        const contact *c = &w->contacts.items[contact_index];
+        int sa = w->bodies.ids[c->id_a].slot, sb = w->bodies.ids[c->id_b].slot;
+        if (sa >= 0 && sb >= 0)
+            compound_sub_children(&w->bodies.shapes[sa], &w->bodies.shapes[sb], c->sub, &child[0], &child[1]);
+    }
+    /* the children are written only up to the last event that names one */
+    if (child[0] >= 0 || child[1] >= 0) {
+        if (!array_reserve_near((void **)&b->children, &b->children_capacity, b->count + 1, sizeof *b->children))
+            return 0;
+        for (int i = b->children_count; i < b->count; i++) b->children[i][0] = b->children[i][1] = -1;
+        b->children[b->count][0] = child[0];
+        b->children[b->count][1] = child[1];
+        b->children_count = b->count + 1;
+    }
     b->items[b->count++] = *e;
-    if (contact_index < 0) return 1; /* not from a contact (sensors) */
-    const contact *c = &w->contacts.items[contact_index];
-    int sa = w->bodies.ids[c->id_a].slot, sb = w->bodies.ids[c->id_b].slot;
-    if (sa >= 0 && sb >= 0)
-        compound_sub_children(&w->bodies.shapes[sa], &w->bodies.shapes[sb], c->sub, &children[0], &children[1]);
     return 1;
 }
 

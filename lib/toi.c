@@ -23,6 +23,7 @@
  * fraction changes (a box stopped by one body must stop the one behind it). */
 #include <stdlib.h>
 #include <string.h>
+#include "array.h"
 #include "filter.h"
 #include "compound.h"
 #include "gjk.h"
@@ -120,15 +121,31 @@ typedef struct sweep {
     int moving;           /* 0: at rest all step (static, sleeping) */
 } sweep;
 
+/* A body the sweeps read: its motion and where it stops (1 = its end pose). */
+typedef struct toi_body {
+    sweep sw;
+    double fraction;
+} toi_body;
+
+/* The bodies a step's sweeps read are the fast ones and those near their
+ * paths, a few of the world's: each gets its toi_body when first read (the
+ * same sweep at any time: nothing the sweep reads changes before the
+ * bodies are moved back), found through the slot's index (one int a slot
+ * instead of a sweep and a fraction: 6.8 MB at 50,000 bodies with one of
+ * them fast). */
 typedef struct toi_context {
     carom_world *w;
-    sweep *sweeps;        /* per store slot */
-    double *fraction;     /* per store slot: where the body stops (1 = its end pose) */
+    const step_context *step;
+    int *index;           /* per store slot: its toi_body + 1, 0: none yet */
+    toi_body *bodies;     /* step_scratch.toi_bodies */
     int slot;             /* the body being swept */
     double target, slop;  /* separation to stop at, allowed extra sinking of a touching pair */
     int changed;
-    int *near, near_count; /* the slots the swept body's query found (room for every slot) */
+    int *near, near_count; /* the slots the swept body's query found (step_scratch.toi_near) */
+    int failed;           /* out of memory */
 } toi_context;
+
+static toi_body *toi_of(const toi_context *ctx, int slot) { return &ctx->bodies[ctx->index[slot] - 1]; }
 
 static xform pose_at(const carom_world *w, const sweep *sw, double f, int slot, double t)
 {
@@ -264,8 +281,9 @@ static double separation_at(const toi_context *ctx, int a, int b, double t, doub
 {
     const carom_world *w = ctx->w;
     const body_store *s = &w->bodies;
-    xform xa = pose_at(w, &ctx->sweeps[a], ctx->fraction[a], a, t);
-    xform xb = pose_at(w, &ctx->sweeps[b], ctx->fraction[b], b, t);
+    const toi_body *ta = toi_of(ctx, a), *tb = toi_of(ctx, b);
+    xform xa = pose_at(w, &ta->sw, ta->fraction, a, t);
+    xform xb = pose_at(w, &tb->sw, tb->fraction, b, t);
     double far;
     if (*try_far) {
         if (toi_far_separation(&s->shapes[a], xa, &s->shapes[b], xb, range, &far, normal)) return far;
@@ -298,7 +316,8 @@ static double separation_at(const toi_context *ctx, int a, int b, double t, doub
  * separation, or limit when they do not. */
 static double pair_toi(const toi_context *ctx, int a, int b, double limit)
 {
-    const sweep *sa = &ctx->sweeps[a], *sb = &ctx->sweeps[b];
+    const toi_body *ta = toi_of(ctx, a), *tb = toi_of(ctx, b);
+    const sweep *sa = &ta->sw, *sb = &tb->sw;
     double ra = sa->moving ? sa->turn : 0.0;
     double rb = sb->moving ? sb->turn : 0.0;
     double la = sa->moving ? v3_len(sa->dc) : 0.0, lb = sb->moving ? v3_len(sb->dc) : 0.0;
@@ -313,14 +332,14 @@ static double pair_toi(const toi_context *ctx, int a, int b, double limit)
     double t = 0.0, d = d0;
     for (int it = 0; it < TOI_MAX_ITERATIONS; it++) {
         if (d <= stop + tolerance) return t;
-        vec3 dca = sa->moving && t < ctx->fraction[a] ? sa->dc : v3_zero();
-        vec3 dcb = sb->moving && t < ctx->fraction[b] ? sb->dc : v3_zero();
+        vec3 dca = sa->moving && t < ta->fraction ? sa->dc : v3_zero();
+        vec3 dcb = sb->moving && t < tb->fraction ? sb->dc : v3_zero();
         double bound = v3_dot(v3_sub(dca, dcb), n);
-        bound = dmax(bound, 0.0) + (t < ctx->fraction[a] ? ra : 0.0) + (t < ctx->fraction[b] ? rb : 0.0);
+        bound = dmax(bound, 0.0) + (t < ta->fraction ? ra : 0.0) + (t < tb->fraction ? rb : 0.0);
         /* the bound holds until one of them stops (if either does) */
         double next = limit;
-        if (t < ctx->fraction[a] && ctx->fraction[a] < next) next = ctx->fraction[a];
-        if (t < ctx->fraction[b] && ctx->fraction[b] < next) next = ctx->fraction[b];
+        if (t < ta->fraction && ta->fraction < next) next = ta->fraction;
+        if (t < tb->fraction && tb->fraction < next) next = tb->fraction;
         double step = bound > 0.0 ? (d - stop) / bound : INFINITY;
         if (!(t + step < next)) {
             if (next >= limit) return limit; /* nothing closes the gap in time */
@@ -339,7 +358,34 @@ static int collect_near(void *user, int id_index)
 {
     toi_context *ctx = user;
     int other = ctx->w->bodies.ids[id_index].slot;
-    if (other >= 0 && other != ctx->slot) ctx->near[ctx->near_count++] = other;
+    if (other < 0 || other == ctx->slot) return 1;
+    step_scratch *sc = &ctx->w->scratch;
+    /* with the merge space of the sort after them */
+    if (!array_reserve_near((void **)&sc->toi_near, &sc->toi_near_capacity, 2 * (ctx->near_count + 1),
+                            sizeof *sc->toi_near)) {
+        ctx->failed = 1;
+        return 0;
+    }
+    ctx->near = sc->toi_near;
+    ctx->near[ctx->near_count++] = other;
+    return 1;
+}
+
+static sweep make_sweep(const carom_world *w, const step_context *step, int slot);
+
+/* Gives the slot its toi_body (its sweep, not stopped) if it has none; 0 on out of memory. */
+static inline int toi_add(toi_context *ctx, int slot)
+{
+    if (ctx->index[slot]) return 1;
+    step_scratch *sc = &ctx->w->scratch;
+    if (!array_reserve_near((void **)&sc->toi_bodies, &sc->toi_body_capacity, sc->toi_body_count + 1,
+                            sizeof *sc->toi_bodies))
+        return 0;
+    ctx->bodies = sc->toi_bodies;
+    toi_body *tb = &ctx->bodies[sc->toi_body_count++];
+    tb->sw = make_sweep(ctx->w, ctx->step, slot);
+    tb->fraction = 1.0;
+    ctx->index[slot] = sc->toi_body_count;
     return 1;
 }
 
@@ -349,14 +395,16 @@ static void sweep_against(toi_context *ctx, int other)
     int self = ctx->slot;
     if ((s->flags[other] | s->flags[self]) & BODY_SENSOR) return; /* sensors never stop a body */
     if (!filter_pair_allowed(ctx->w, self, other)) return; /* the bits and the world's pair filter */
-    double limit = ctx->fraction[self];
+    if (!toi_add(ctx, other)) { ctx->failed = 1; return; }
+    toi_body *ts = toi_of(ctx, self), *to = toi_of(ctx, other);
+    double limit = ts->fraction;
     /* a moving dynamic body can be stopped too: meeting sooner binds it */
-    int other_stops = s->type[other] == CAROM_BODY_DYNAMIC && ctx->sweeps[other].moving;
-    if (other_stops) limit = dmax(limit, ctx->fraction[other]);
+    int other_stops = s->type[other] == CAROM_BODY_DYNAMIC && to->sw.moving;
+    if (other_stops) limit = dmax(limit, to->fraction);
     if (!(limit > 0.0)) return;
     double t = pair_toi(ctx, self, other, limit);
-    if (t < ctx->fraction[self]) { ctx->fraction[self] = t; ctx->changed = 1; }
-    if (other_stops && t < ctx->fraction[other]) { ctx->fraction[other] = t; ctx->changed = 1; }
+    if (t < ts->fraction) { ts->fraction = t; ctx->changed = 1; }
+    if (other_stops && t < to->fraction) { to->fraction = t; ctx->changed = 1; }
 }
 
 static sweep make_sweep(const carom_world *w, const step_context *step, int slot)
@@ -418,45 +466,50 @@ int world_continuous(carom_world *w, const step_context *step)
     body_store *s = &w->bodies;
     step_scratch *sc = &w->scratch;
     int n = s->count;
-    int any = 0;
-    for (int i = 0; i < n && !any; i++) any = may_need_sweep(w, step, i);
-    if (!any) return 1;
-    /* per slot: the sweep, the stop fraction, the swept bodies and the near
-     * ones of one sweep (each with the merge space of its sort) */
-    size_t need = (sizeof(sweep) + sizeof(double) + 4 * sizeof(int)) * (size_t)(n > 0 ? n : 1);
+    int first = 0; /* the first slot that may need a sweep */
+    while (first < n && !may_need_sweep(w, step, first)) first++;
+    if (first == n) return 1;
+    /* per slot: its toi_body's index; then the fast bodies, with the merge space of their sort */
+    size_t need = sizeof(int) * (size_t)(n > 0 ? n : 1);
     if (sc->toi_capacity < need) {
         void *p = realloc(sc->toi, need);
         if (!p) return 0;
         sc->toi = p;
         sc->toi_capacity = need;
     }
-    sweep *sweeps = sc->toi;
-    double *fraction = (double *)(sweeps + n);
-    int *fast = (int *)(fraction + n);
+    toi_context ctx = {w, step, sc->toi, sc->toi_bodies, -1, 0.5 * TOI_SINK, TOI_SINK, 1, sc->toi_near, 0, 0};
+    memset(ctx.index, 0, sizeof *ctx.index * (size_t)n);
+    sc->toi_body_count = 0;
     int fast_count = 0;
-    for (int i = 0; i < n; i++) {
-        sweeps[i] = make_sweep(w, step, i);
-        fraction[i] = 1.0;
-        if (s->type[i] != CAROM_BODY_DYNAMIC || !sweeps[i].moving) continue;
+    /* the fast bodies: only those may_need_sweep's bound leaves can have
+     * travelled farther than their thickness (a bullet always may) */
+    for (int i = first; i < n; i++) {
+        if (i > first && !may_need_sweep(w, step, i)) continue;
+        if (!toi_add(&ctx, i)) return 0;
+        const sweep *sw = &toi_of(&ctx, i)->sw;
+        if (!sw->moving) continue;
         /* how far any surface point moved: the centre's travel plus the turn at the reach */
-        double travel = v3_len(sweeps[i].dc) + sweeps[i].turn;
+        double travel = v3_len(sw->dc) + sw->turn;
         int bullet = (s->flags[i] & BODY_BULLET) != 0;
         if (!(travel > 0) || !isfinite(travel)) continue;
         if (!bullet && travel <= min_extent(&s->shapes[i])) continue;
-        fast[fast_count++] = i;
+        if (!array_reserve_near((void **)&sc->toi_fast, &sc->toi_fast_capacity, 2 * (fast_count + 1),
+                                sizeof *sc->toi_fast))
+            return 0;
+        sc->toi_fast[fast_count++] = i;
     }
     if (fast_count == 0) return 1;
+    int *fast = sc->toi_fast;
     /* swept in rank order (collision.c), not by slot, and each against the
      * bodies near its path in rank order, not the tree's: a body stopped by
      * one pair is stopped sooner for later ones, so the order must not
      * follow creation (docs/physics.md, "Creation order") */
-    world_rank_sort(s, fast, fast + n, fast_count);
-    toi_context ctx = {w, sweeps, fraction, -1, 0.5 * TOI_SINK, TOI_SINK, 1, fast + 2 * n, 0};
+    world_rank_sort(s, fast, fast + fast_count, fast_count);
     for (int pass = 0; pass < TOI_MAX_PASSES && ctx.changed; pass++) {
         ctx.changed = 0;
         for (int k = 0; k < fast_count; k++) {
             int i = fast[k];
-            const sweep *sw = &sweeps[i];
+            const sweep *sw = &toi_of(&ctx, i)->sw;
             ctx.slot = i;
             /* everything the body's surface can reach along its path */
             vec3 c1 = v3_add(sw->c0, sw->dc);
@@ -464,13 +517,17 @@ int world_continuous(carom_world *w, const step_context *step)
             aabb box = {v3_sub(v3_min(sw->c0, c1), v3(r, r, r)), v3_add(v3_max(sw->c0, c1), v3(r, r, r))};
             ctx.near_count = 0;
             bp_query(w->bp, box, collect_near, &ctx);
-            world_rank_sort(s, ctx.near, ctx.near + n, ctx.near_count);
+            if (ctx.failed) return 0;
+            world_rank_sort(s, ctx.near, ctx.near + ctx.near_count, ctx.near_count);
             for (int j = 0; j < ctx.near_count; j++) sweep_against(&ctx, ctx.near[j]);
+            if (ctx.failed) return 0;
         }
     }
     for (int i = 0; i < n; i++) {
-        if (!(fraction[i] < 1.0)) continue;
-        xform x = pose_at(w, &sweeps[i], fraction[i], i, fraction[i]);
+        if (!ctx.index[i]) continue;
+        const toi_body *tb = toi_of(&ctx, i);
+        if (!(tb->fraction < 1.0)) continue;
+        xform x = pose_at(w, &tb->sw, tb->fraction, i, tb->fraction);
         s->rotation[i] = x.q;
         s->center[i] = v3_add(x.p, q_rotate(x.q, s->local_center[i]));
         body_update_inertia(s, i);

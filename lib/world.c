@@ -211,7 +211,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
     free(s->tight_box); free(s->pose); free(s->touching); free(s->mixed);
     free(w->sensor_overlaps);
-    free(s->new_pairs); free(s->asleep_pairs); free(s->toi); free(s->merged);
+    free(s->new_pairs); free(s->asleep_pairs); free(s->toi); free(s->toi_bodies); free(s->toi_fast); free(s->toi_near); free(s->merged);
     free(w);
 }
 
@@ -250,8 +250,9 @@ CAROM_API carom_status carom_world_get_event_children(const carom_world *w, int 
     if (index < 0 || index >= w->events.count)
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "world_get_event_children: index %d outside 0..%d", index,
                           w->events.count - 1);
-    if (child_a) *child_a = w->events.children[index][0];
-    if (child_b) *child_b = w->events.children[index][1];
+    int named = index < w->events.children_count; /* later events name no child */
+    if (child_a) *child_a = named ? w->events.children[index][0] : -1;
+    if (child_b) *child_b = named ? w->events.children[index][1] : -1;
     return CAROM_OK;
 }
 
@@ -306,6 +307,7 @@ CAROM_API carom_status carom_world_step(carom_world *w, double dt)
     step_context ctx;
     step_context_init(&ctx, &w->def, dt);
     w->events.count = 0;
+    w->events.children_count = 0;
     world_remember_poses(w);
     w->stats.clamped = 0;
     w->stats.toi_events = 0;

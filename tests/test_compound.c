@@ -288,6 +288,58 @@ static void expect_refused(carom_world *w, const carom_compound_child *c, int n,
     assert_non_null(strstr(carom_world_last_error(w), words));
 }
 
+/* Events of plain pairs name no child, before and after a compound's in the
+ * same step (the children are kept only up to the last event naming one). */
+static void test_plain_events_beside_compound_name_none(void **state)
+{
+    (void)state;
+    carom_world *w = world_default();
+    carom_body_def pd = carom_body_def_default();
+    pd.type = CAROM_BODY_STATIC;
+    pd.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(w, &pd);
+    carom_compound_child c[3];
+    dumbbell(c, 0.1, 0.5, 0.02, 0.4, 1000, 0);
+    carom_body_id boxes[8];
+    carom_body_id compound = {0};
+    /* boxes beside the dumbbell on the plane, the last one on top of the one before it: pairs
+     * come in rank order (docs/physics.md 1.1), the plane's pairs first, then the stacked boxes' */
+    for (int k = 0; k < 9; k++) {
+        carom_vec3 at = {3.0 * (k - 4), 0, k == 4 ? 0.1 : 0.5};
+        if (k == 8) { at.x = 3.0 * 3; at.z = 1.5; }
+        if (k == 4) { compound = add_compound(w, c, 3, CAROM_BODY_DYNAMIC, at); continue; }
+        carom_body_def bd = carom_body_def_default();
+        bd.shape = carom_shape_box(0.5, 0.5, 0.5);
+        bd.position = at;
+        boxes[k < 4 ? k : k - 1] = carom_body_create(w, &bd);
+    }
+    carom_world_step(w, 1.0 / 60.0);
+    const carom_contact_event *ev;
+    int n = carom_world_get_events(w, &ev), first_compound = -1, last_compound = -1, plain = 0, plain_after = 0;
+    for (int k = 0; k < n; k++) {
+        if (ev[k].type != CAROM_EVENT_BEGIN) continue;
+        int ca = -5, cb = -5;
+        assert_int_equal(carom_world_get_event_children(w, k, &ca, &cb), CAROM_OK);
+        if (carom_body_id_equal(ev[k].a, compound) || carom_body_id_equal(ev[k].b, compound)) {
+            int mine = carom_body_id_equal(ev[k].a, compound) ? ca : cb, other = carom_body_id_equal(ev[k].a, compound) ? cb : ca;
+            assert_true(mine >= 0 && mine <= 1); /* a sphere touches the plane */
+            assert_int_equal(other, -1);
+            if (first_compound < 0) first_compound = k;
+            last_compound = k;
+        } else {
+            assert_int_equal(ca, -1);
+            assert_int_equal(cb, -1);
+            plain++;
+            plain_after += last_compound >= 0;
+        }
+    }
+    assert_true(first_compound >= 0);
+    assert_int_equal(plain, 8); /* 7 boxes on the plane, 1 on a box */
+    assert_true(plain_after > 0 && plain_after < plain); /* plain events on both sides of the compound's */
+    (void)boxes;
+    carom_world_destroy(w);
+}
+
 static void test_bad_compounds_refused(void **state)
 {
     (void)state;
@@ -333,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_dumbbell_rolls_as_analytic),
         cmocka_unit_test(test_table_stands_on_mesh),
         cmocka_unit_test(test_child_in_ray_casts_and_events),
+        cmocka_unit_test(test_plain_events_beside_compound_name_none),
         cmocka_unit_test(test_bad_compounds_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
