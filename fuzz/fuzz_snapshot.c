@@ -4,12 +4,66 @@
  * fuzzer reaches the structural checks behind them. Invariants: no sanitizer
  * report; a refused input has a "snapshot: " message; an accepted one steps
  * with everything finite and snapshots back to exactly its own bytes (a
- * format-7 one, still read, to format-8 bytes that read back to themselves). */
+ * format-7 one, still read, to format-8 bytes that read back to themselves).
+ * carom_world_restore_into takes every input as carom_world_restore does,
+ * and a refused one leaves its world unchanged. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "carom/carom.h"
 #include "fuzz_common.h"
+
+/* A world's snapshot, malloc'd (*n its size). */
+static uint8_t *snapshot_of(const carom_world *w, size_t *n)
+{
+    *n = carom_world_snapshot(w, NULL, 0);
+    uint8_t *b = malloc(*n ? *n : 1);
+    if (!b || carom_world_snapshot(w, b, *n) != *n) abort();
+    return b;
+}
+
+/* carom_world_restore_into a world that holds another state (a box on a
+ * plane, stepped): twice, so the second reads into the first's spare. A
+ * refused input must leave the world's snapshot as it was, with the
+ * reader's reason; an accepted one must make it the snapshot's world (its
+ * snapshot `expect`). */
+static void check_restore_into(const uint8_t *input, size_t size, const uint8_t *expect, size_t expect_size)
+{
+    carom_world_def wd = carom_world_def_default();
+    carom_world *w = carom_world_create(&wd);
+    if (!w) abort();
+    carom_body_def b = carom_body_def_default();
+    b.type = CAROM_BODY_STATIC;
+    b.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(w, &b);
+    b = carom_body_def_default();
+    b.position.z = 0.5;
+    carom_body_create(w, &b);
+    carom_world_step(w, 1.0 / 60);
+    for (int round = 0; round < 2; round++) {
+        size_t before_size;
+        uint8_t *before = snapshot_of(w, &before_size);
+        carom_status st = carom_world_restore_into(w, input, size);
+        size_t after_size;
+        uint8_t *after = snapshot_of(w, &after_size);
+        if (!expect) {
+            if (st == CAROM_OK || strncmp(carom_world_last_error(w), "world_restore_into: snapshot: ", 30) != 0) {
+                fprintf(stderr, "restore_into: a refused snapshot was not refused with its reason: %s\n", carom_world_last_error(w));
+                abort();
+            }
+            if (after_size != before_size || memcmp(after, before, after_size) != 0) {
+                fprintf(stderr, "restore_into: a refused snapshot changed the world\n");
+                abort();
+            }
+        } else if (st != CAROM_OK || after_size != expect_size || memcmp(after, expect, expect_size) != 0) {
+            fprintf(stderr, "restore_into: an accepted snapshot did not become the world (%s)\n", carom_world_last_error(w));
+            abort();
+        }
+        free(before);
+        free(after);
+    }
+    carom_world_destroy(w);
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -23,6 +77,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     carom_world *w = carom_world_restore(copy, size, msg, sizeof msg);
     if (!w) {
         if (strncmp(msg, "snapshot: ", 10) != 0) { fprintf(stderr, "refused without a message: %s\n", msg); abort(); }
+        check_restore_into(copy, size, NULL, 0);
         free(copy);
         return 0;
     }
@@ -45,6 +100,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         fprintf(stderr, "restore then snapshot is not the input\n");
         abort();
     }
+    check_restore_into(copy, size, again, n);
     free(again);
     for (int i = 0; i < 3; i++) {
         if (carom_world_step(w, 1.0 / 60) != CAROM_OK) break;

@@ -76,6 +76,16 @@ void bp_destroy(broadphase *bp)
     free(bp);
 }
 
+void bp_clear(broadphase *bp)
+{
+    bp->free_list = bp->tail_list = NULL_NODE;
+    bp->fresh = 0;
+    bp->free_count = bp->capacity;
+    bp->root[MOVING_TREE] = bp->root[STATIC_TREE] = NULL_NODE;
+    bp->move_count = 0;
+    bp->proxy_count = 0;
+}
+
 /* Makes at least `need` nodes free. Returns 0 on out of memory, changing nothing visible. */
 static int reserve_nodes(broadphase *bp, int need)
 {

@@ -25,6 +25,9 @@ void bp_destroy_proxy(broadphase *bp, int proxy);
  * centres instead of one insertion at a time; proxy[i] gets box[i]'s id. Every new proxy counts as
  * moved. Returns 0 when out of memory, changing nothing. */
 int bp_create_proxies(broadphase *bp, const aabb *box, const int *is_static, const int *user, int n, int *proxy);
+/* Removes every proxy at once, keeping the memory (a restore into an
+ * existing world reads the next state into it). */
+void bp_clear(broadphase *bp);
 /* Replaces the proxy's box and marks it moved. */
 void bp_move_proxy(broadphase *bp, int proxy, aabb box);
 aabb bp_get_aabb(const broadphase *bp, int proxy);

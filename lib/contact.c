@@ -210,6 +210,16 @@ int contact_set_reserve(contact_set *cs, int n)
            array_reserve((void **)&cs->data, &cs->data_capacity, n + 1, sizeof *cs->data);
 }
 
+void contact_set_clear(contact_set *cs)
+{
+    cs->count = 0;
+    cs->data_count = 1; /* (data[0], the empty record, is never written) */
+    cs->free_head = 0;
+    cs->free_count = 0;
+    cs->map.count = 0;
+    if (cs->map.values) memset(cs->map.values, 0xff, (size_t)cs->map.capacity * sizeof *cs->map.values);
+}
+
 void contact_set_trim(contact_set *cs)
 {
     if (cs->data_capacity <= cs->data_count) return;
@@ -251,12 +261,22 @@ int contact_set_index(contact_set *cs, int *repeated)
      * slots span a few cache lines, and start[] stays small */
     int bucket_bits = bits < 12 ? bits : 12, shift = bits - bucket_bits;
     uint32_t mask = (uint32_t)capacity - 1;
+    /* the map's arrays are reused when they have the size (a restore into
+     * an existing world: pages already written) */
     pair_map m;
-    int ok = map_init(&m, capacity);
+    int reuse = cs->map.capacity == capacity && cs->map.hashes && cs->map.values;
+    int ok = 1;
+    if (reuse) {
+        m = cs->map;
+        m.count = 0;
+        if (cs->map.count) memset(m.values, 0xff, (size_t)capacity * sizeof *m.values);
+    } else {
+        ok = map_init(&m, capacity);
+    }
     int *start = calloc(((size_t)1 << bucket_bits) + 1, sizeof *start);
     pair_record *rec = malloc(sizeof *rec * 2 * (size_t)(n > 0 ? n : 1)), *sorted = rec ? rec + n : NULL;
     if (!ok || !start || !rec) {
-        map_free(&m);
+        if (!reuse) map_free(&m);
         free(start);
         free(rec);
         return 0;
@@ -289,7 +309,7 @@ int contact_set_index(contact_set *cs, int *repeated)
     }
     free(start);
     free(rec);
-    map_free(&old);
+    if (!reuse) map_free(&old);
     return 1;
 }
 

@@ -110,6 +110,9 @@ int contact_add(contact_set *cs, int a, int b);
 /* Room for n contacts without growing the arrays (restoring a snapshot: the
  * map is built by contact_set_index). 0 on out of memory. */
 int contact_set_reserve(contact_set *cs, int n);
+/* Removes every contact, keeping the memory (a restore into an existing
+ * world: the map is rebuilt by contact_set_index). */
+void contact_set_clear(contact_set *cs);
 /* Gives back the pool's room beyond the slots in use (after restoring). */
 void contact_set_trim(contact_set *cs);
 /* The same for a pair's extra manifold number sub (> 0). */

@@ -114,6 +114,10 @@ typedef struct reader {
     size_t msg_size;
     int failed;
     unsigned version;       /* the snapshot's format (SNAP_VERSION_OLDEST .. SNAP_VERSION) */
+    int out_of_memory;      /* the failure was memory, not the data */
+    carom_world *into;      /* a world whose memory the state is to be read into (restore_into's
+                               spare), until read_world takes it; NULL: a new world */
+    int reuse;              /* the world read into is such a one */
 } reader;
 
 /* The reader's pose checks: a quaternion more than 1e-6 from unit length, and
@@ -149,6 +153,12 @@ static int bad(reader *r, const char *fmt, ...)
     }
     r->failed = 1;
     return 0;
+}
+
+static int no_memory(reader *r)
+{
+    r->out_of_memory = !r->failed;
+    return bad(r, "out of memory");
 }
 
 static int need(reader *r, size_t n, const char *what)
@@ -708,12 +718,12 @@ static hull *read_hull(reader *r)
     size_t bytes = (size_t)nv * 24 + (size_t)nf * 40 + (size_t)nfv * 4 + (size_t)ne * 8 + 104;
     if (!need(r, bytes, "hull")) return NULL;
     hull *h = calloc(1, sizeof *h);
-    if (!h) return bad(r, "out of memory"), NULL;
+    if (!h) return no_memory(r), NULL;
     h->vertices = malloc(sizeof *h->vertices * (size_t)nv);
     h->faces = malloc(sizeof *h->faces * (size_t)nf);
     h->face_vertices = malloc(sizeof *h->face_vertices * (size_t)nfv);
     h->edges = malloc(sizeof *h->edges * (size_t)ne);
-    if (!h->vertices || !h->faces || !h->face_vertices || !h->edges) { hull_free(h); return bad(r, "out of memory"), NULL; }
+    if (!h->vertices || !h->faces || !h->face_vertices || !h->edges) { hull_free(h); return no_memory(r), NULL; }
     h->vertex_count = nv;
     h->face_count = nf;
     h->edge_count = ne;
@@ -771,7 +781,7 @@ static tri_mesh *read_mesh(reader *r)
         return bad(r, "mesh counts (%d vertices, %d triangles, %d nodes) are out of range", nv, nt, nn), NULL;
     if (!need(r, (size_t)nv * 24 + (size_t)nt * 17 + (size_t)nn * 56, "mesh")) return NULL;
     tri_mesh *m = calloc(1, sizeof *m);
-    if (!m) return bad(r, "out of memory"), NULL;
+    if (!m) return no_memory(r), NULL;
     m->two_sided = two_sided;
     m->vertex_count = nv;
     m->triangle_count = nt;
@@ -785,7 +795,7 @@ static tri_mesh *read_mesh(reader *r)
     if (!m->vertices || !m->triangles || !m->source_index || !m->active || !m->nodes || !parents) {
         free(parents);
         mesh_free(m);
-        return bad(r, "out of memory"), NULL;
+        return no_memory(r), NULL;
     }
     for (int i = 0; i < nv && !r->failed; i++) {
         m->vertices[i] = get_v3(r, "mesh vertex");
@@ -835,12 +845,12 @@ static height_field *read_field(reader *r)
     size_t points = (size_t)rows * (size_t)columns;
     if (!need(r, points * 8 + 4, "height field")) return NULL;
     double *heights = malloc(sizeof *heights * points);
-    if (!heights) return bad(r, "out of memory"), NULL;
+    if (!heights) return no_memory(r), NULL;
     for (size_t i = 0; i < points; i++) heights[i] = get_f64(r, "height");
     int cells = (rows - 1) * (columns - 1);
     int holes = get_count(r, 4, cells, "height field hole count");
     int *hole = malloc(sizeof *hole * (size_t)(holes > 0 ? holes : 1));
-    if (!hole) { free(heights); return bad(r, "out of memory"), NULL; }
+    if (!hole) { free(heights); return no_memory(r), NULL; }
     for (int i = 0; i < holes; i++) {
         hole[i] = get_i32(r, "height field hole");
         if (!r->failed && i > 0 && hole[i] <= hole[i - 1]) bad(r, "height field holes are not increasing");
@@ -865,7 +875,7 @@ static compound *read_compound(reader *r)
     if (n < 1 || n > 256) return bad(r, "compound of %d children", n), NULL;
     if (!need(r, (size_t)n * 99, "compound")) return NULL;
     compound *c = compound_alloc(n);
-    if (!c) return bad(r, "out of memory"), NULL;
+    if (!c) return no_memory(r), NULL;
     for (int i = 0; i < n; i++) {
         c->poses[i].p = get_v3(r, "compound child pose");
         c->poses[i].q = get_q(r, "compound child pose");
@@ -1730,11 +1740,14 @@ static int read_ids(reader *r, body_store *s)
     int free_id = get_small(r, 0, id_count, 0, "free id") - 1;
     if (r->failed) return 0;
     if ((size_t)id_count * 3 > r->size - r->pos) return bad(r, "truncated: %d ids need more than the bytes left", id_count);
-    body_id_entry *ids = malloc(sizeof *ids * (size_t)(id_count > 0 ? id_count : 1));
-    if (!ids) return bad(r, "out of memory");
-    free(s->ids);
-    s->ids = ids;
-    s->id_capacity = id_count > 0 ? id_count : 1;
+    body_id_entry *ids = s->ids;
+    if (!ids || s->id_capacity < id_count) {
+        ids = malloc(sizeof *ids * (size_t)(id_count > 0 ? id_count : 1));
+        if (!ids) return no_memory(r);
+        free(s->ids);
+        s->ids = ids;
+        s->id_capacity = id_count > 0 ? id_count : 1;
+    }
     s->id_count = 0;
     s->free_id = -1;
     for (int i = 0; i < id_count && !r->failed; i++) {
@@ -1778,7 +1791,7 @@ static int distinct_classes(reader *r, const body_class *k, int n)
     int cap = 16;
     while (cap < 2 * n) cap *= 2;
     int *slots = malloc(sizeof *slots * (size_t)cap);
-    if (!slots) return bad(r, "out of memory");
+    if (!slots) return no_memory(r);
     for (int i = 0; i < cap; i++) slots[i] = -1;
     for (int c = 0; c < n; c++) {
         size_t len = k[c].end - k[c].start;
@@ -1833,7 +1846,7 @@ static int class_shape(reader *r, const body_class *k, shape *out)
     case SHAPE_HULL:
         *out = *ks;
         out->hull = hull_clone(ks->hull);
-        return out->hull ? 1 : bad(r, "out of memory");
+        return out->hull ? 1 : no_memory(r);
     default: {
         reader sr = *r;
         sr.pos = k->shape_at;
@@ -1853,7 +1866,7 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
     if (r->failed) return 0;
     if ((size_t)class_count * 200 > r->size - r->pos) return bad(r, "truncated: %d body classes", class_count);
     body_class *classes = calloc((size_t)(class_count > 0 ? class_count : 1), sizeof *classes);
-    if (!classes) return bad(r, "out of memory");
+    if (!classes) return no_memory(r);
     for (int k = 0; k < class_count; k++)
         if (!read_class(r, &classes[k])) { free_classes(classes, class_count); return 0; }
     if (!distinct_classes(r, classes, class_count)) { free_classes(classes, class_count); return 0; }
@@ -1862,21 +1875,25 @@ static int read_bodies(reader *r, carom_world *w, int **class_of)
         free_classes(classes, class_count);
         return r->failed ? 0 : bad(r, "truncated: %d bodies need more than the bytes left", count);
     }
-    /* the dense arrays, sized for the bodies (the id table is kept aside meanwhile) */
-    body_id_entry *ids = s->ids;
-    int id_count = s->id_count, free_id = s->free_id, id_capacity = s->id_capacity;
-    s->ids = NULL;
-    body_store_free(s);
-    int ok = body_store_init(s, count);
-    free(s->ids);
-    s->ids = ids;
-    s->id_capacity = id_capacity;
-    s->id_count = id_count;
-    s->free_id = free_id;
-    if (!ok) { free_classes(classes, class_count); return bad(r, "out of memory"); }
+    /* the dense arrays, sized for the bodies (the id table is kept aside
+     * meanwhile), unless they have the room (a spare's) */
+    int ok = 1;
+    if (s->capacity < count) {
+        body_id_entry *ids = s->ids;
+        int id_count = s->id_count, free_id = s->free_id, id_capacity = s->id_capacity;
+        s->ids = NULL;
+        body_store_free(s);
+        ok = body_store_init(s, count);
+        free(s->ids);
+        s->ids = ids;
+        s->id_capacity = id_capacity;
+        s->id_count = id_count;
+        s->free_id = free_id;
+    }
+    if (!ok) { free_classes(classes, class_count); return no_memory(r); }
     if (!check_ids(r, s, count)) { free_classes(classes, class_count); return 0; }
     *class_of = malloc(sizeof **class_of * (size_t)(count > 0 ? count : 1));
-    if (!*class_of) { free_classes(classes, class_count); return bad(r, "out of memory"); }
+    if (!*class_of) { free_classes(classes, class_count); return no_memory(r); }
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
@@ -1997,7 +2014,7 @@ static int read_sensor_overlaps(reader *r, carom_world *w)
     if ((size_t)count * 16 > r->size - r->pos) return bad(r, "truncated: %d sensor overlaps", count);
     if (count == 0) return 1;
     sensor_overlap *pairs = malloc(sizeof *pairs * (size_t)count);
-    if (!pairs) return bad(r, "out of memory");
+    if (!pairs) return no_memory(r);
     for (int i = 0; i < count; i++) {
         pairs[i].sensor = carom_body_id_unpack(get_u64(r, "sensor overlap"));
         pairs[i].other = carom_body_id_unpack(get_u64(r, "sensor overlap"));
@@ -2021,15 +2038,15 @@ static int read_contacts(reader *r, carom_world *w, const int *class_of)
     int count = get_small(r, 0, 1 << 28, 0, "contact count");
     if (r->failed) return 0;
     if ((size_t)count * 3 > r->size - r->pos) return bad(r, "truncated: %d contacts need more than the bytes left", count); /* (the shortest record: 3 bytes) */
-    if (!contact_set_reserve(cs, count)) return bad(r, "out of memory");
+    if (!contact_set_reserve(cs, count)) return no_memory(r);
     mix_memo *memo = malloc(sizeof *memo); /* (without it, every contact mixes its own) */
     if (memo) mix_memo_init(memo, class_of);
     int ok = read_contact_list(r, w, count, memo);
     free(memo);
     if (!ok) return 0;
     int repeated;
-    if (!contact_set_index(cs, &repeated)) return bad(r, "out of memory");
-    contact_set_trim(cs);
+    if (!contact_set_index(cs, &repeated)) return no_memory(r);
+    if (!r->reuse) contact_set_trim(cs); /* (a spare keeps its room for the next restore) */
     if (repeated >= 0) {
         const contact *c = &cs->items[repeated];
         return bad(r, "contact %d repeats the pair (%d, %d) manifold %u", repeated, c->id_a < c->id_b ? c->id_a : c->id_b,
@@ -2103,7 +2120,7 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
          * material (most broadphase pairs of a settled pile) */
         int keep = (flags & (CONTACT_TOUCHING | CONTACT_WAS_TOUCHING | CONTACT_ANY_TOUCHING | CONTACT_REUSABLE)) ||
                    (bits & (7 | CREC_NORMAL | CREC_TANGENT | CREC_TANGENT_GUESS | CREC_MATERIAL));
-        if (ci < 0 || (keep && !contact_data_alloc(cs, ci))) return bad(r, "out of memory");
+        if (ci < 0 || (keep && !contact_data_alloc(cs, ci))) return no_memory(r);
         contact *c = &cs->items[ci];
         contact_data *d = keep ? CONTACT_DATA(cs, ci) : scratch;
         int sa = s->ids[a].slot, sb = s->ids[b].slot;
@@ -2206,60 +2223,174 @@ static int read_contact_list(reader *r, carom_world *w, int count, mix_memo *mem
     return !r->failed;
 }
 
+/* carom_world_restore, and why it refused: *status OUT_OF_MEMORY or
+ * INVALID_ARGUMENT (the data). into: a world to read into (keeping its
+ * memory), or NULL for a new one; it is destroyed when the data is refused. */
+static carom_world *restore_world(const void *data, size_t size, char *msg, size_t msg_size, carom_world *into,
+                                  carom_status *status);
+
+/* A spare world emptied for the next state, its memory kept (everything a
+ * new world would hold is reset; what the reader sets is left to it). */
+static void clear_state(carom_world *w)
+{
+    body_store *s = &w->bodies;
+    for (int i = 0; i < s->count; i++) shape_free_data(&s->shapes[i]);
+    s->count = 0;
+    bp_clear(w->bp);
+    contact_set_clear(&w->contacts);
+    free(w->sensor_overlaps);
+    w->sensor_overlaps = NULL;
+    w->sensor_overlap_count = w->sensor_overlap_capacity = 0;
+    w->events.count = 0;
+    w->stats = carom_world_stats_init();
+    w->filters_settled = 0;
+    w->pair_filter = NULL;
+    w->pair_filter_context = NULL;
+    w->pre_solve = NULL;
+    w->pre_solve_context = NULL;
+}
+
 CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *msg, size_t msg_size)
 {
-    reader r = {data, size, 0, msg, msg_size, 0, SNAP_VERSION};
-    if (msg && msg_size) msg[0] = '\0';
-    if (!data) return bad(&r, "data is NULL"), NULL;
+    carom_status status;
+    return restore_world(data, size, msg, msg_size, NULL, &status);
+}
+
+/* Double-buffered: the new state is read into a world of its own (the
+ * spare, which holds the state before the last restore: its pages are
+ * already the process's, where a new world's would be fresh, about 3,800
+ * page faults for the bench's 10,000 bodies), so a refused snapshot leaves
+ * w as it was; on success w and the spare exchange states (w keeps its
+ * address, the host's handle, and its step scratch) and the old state
+ * becomes the spare. A refused snapshot costs the spare (the next restore
+ * makes a new one). The host's settings are not state and stay: the event
+ * callback, the task hooks, the pair filter and pre-solve callbacks, the
+ * last error, and the user data of every body the snapshot also holds (the
+ * same id and generation). */
+CAROM_API carom_status carom_world_restore_into(carom_world *w, const void *data, size_t size)
+{
+    if (!w) return CAROM_ERROR_INVALID_ARGUMENT;
+    if (w->locked)
+        return world_fail(w, CAROM_ERROR_LOCKED, "world_restore_into: the world is inside its step; restore it afterwards");
+    char msg[WORLD_ERROR_SIZE];
+    carom_status status = CAROM_OK;
+    carom_world *spare = w->spare;
+    w->spare = NULL; /* (restore_world destroys it if the data is refused) */
+    carom_world *n = restore_world(data, size, msg, sizeof msg, spare, &status);
+    if (!n) return world_fail(w, status, "world_restore_into: %s", msg);
+    n->def.event_callback = w->def.event_callback;
+    n->def.event_context = w->def.event_context;
+    n->def.worker_count = w->def.worker_count;
+    n->def.enqueue_task = w->def.enqueue_task;
+    n->def.finish_task = w->def.finish_task;
+    n->def.task_context = w->def.task_context;
+    n->pair_filter = w->pair_filter;
+    n->pair_filter_context = w->pair_filter_context;
+    n->pre_solve = w->pre_solve;
+    n->pre_solve_context = w->pre_solve_context;
+    const body_store *old = &w->bodies;
+    body_store *now = &n->bodies;
+    for (int i = 0; i < old->id_count && i < now->id_count; i++) {
+        int from = old->ids[i].slot, to = now->ids[i].slot;
+        if (from >= 0 && to >= 0 && old->ids[i].generation == now->ids[i].generation) now->user_data[to] = old->user_data[from];
+    }
+    /* the states change places; the scratch, events buffer and last error stay */
+#define SWAP(field) do { swap.field = w->field; w->field = n->field; n->field = swap.field; } while (0)
+    carom_world swap;
+    SWAP(def);
+    SWAP(bodies);
+    SWAP(bp);
+    SWAP(contacts);
+    SWAP(stats);
+    SWAP(filters_settled);
+    SWAP(sensor_overlaps);
+    SWAP(sensor_overlap_count);
+    SWAP(sensor_overlap_capacity);
+#undef SWAP
+    w->events.count = 0; /* (the last step's events are not state) */
+    n->pair_filter = NULL; /* (the spare never steps) */
+    n->pair_filter_context = NULL;
+    n->pre_solve = NULL;
+    n->pre_solve_context = NULL;
+    w->spare = n;
+    return CAROM_OK;
+}
+
+static carom_world *read_world(reader *r);
+
+static carom_world *restore_world(const void *data, size_t size, char *msg, size_t msg_size, carom_world *into,
+                                  carom_status *status)
+{
+    reader r = {data, size, 0, msg, msg_size, 0, SNAP_VERSION, 0, into, 0};
+    *status = CAROM_ERROR_INVALID_ARGUMENT;
+    carom_world *w = read_world(&r);
+    carom_world_destroy(r.into); /* (refused before read_world took it) */
+    if (!w && r.out_of_memory) *status = CAROM_ERROR_OUT_OF_MEMORY;
+    return w;
+}
+
+static carom_world *read_world(reader *r)
+{
+    const void *data = r->buf;
+    size_t size = r->size;
+    if (r->msg && r->msg_size) r->msg[0] = '\0';
+    if (!data) return bad(r, "data is NULL"), NULL;
     if (size < SNAP_HEADER_SIZE || memcmp(data, SNAP_MAGIC, 8) != 0)
-        return bad(&r, "not a carom snapshot (no \"" SNAP_MAGIC "\" header)"), NULL;
-    r.pos = 8;
-    uint32_t version = get_u32(&r, "version"), header = get_u32(&r, "header size");
-    uint64_t total = get_u64(&r, "size"), sum = get_u64(&r, "checksum");
+        return bad(r, "not a carom snapshot (no \"" SNAP_MAGIC "\" header)"), NULL;
+    r->pos = 8;
+    uint32_t version = get_u32(r, "version"), header = get_u32(r, "header size");
+    uint64_t total = get_u64(r, "size"), sum = get_u64(r, "checksum");
     if (version < SNAP_VERSION_OLDEST || version > SNAP_VERSION)
-        return bad(&r, "version %u; this carom reads versions %u to %u", (unsigned)version, SNAP_VERSION_OLDEST, SNAP_VERSION), NULL;
-    r.version = version;
-    if (header != SNAP_HEADER_SIZE) return bad(&r, "header size %u, expected %u", (unsigned)header, SNAP_HEADER_SIZE), NULL;
+        return bad(r, "version %u; this carom reads versions %u to %u", (unsigned)version, SNAP_VERSION_OLDEST, SNAP_VERSION), NULL;
+    r->version = version;
+    if (header != SNAP_HEADER_SIZE) return bad(r, "header size %u, expected %u", (unsigned)header, SNAP_HEADER_SIZE), NULL;
     if (total != size)
-        return bad(&r, "truncated or padded: the header says %llu bytes, %zu given", (unsigned long long)total, size), NULL;
-    if (checksum(r.buf + SNAP_HEADER_SIZE, size - SNAP_HEADER_SIZE) != sum)
-        return bad(&r, "corrupted (checksum mismatch)"), NULL;
+        return bad(r, "truncated or padded: the header says %llu bytes, %zu given", (unsigned long long)total, size), NULL;
+    if (checksum(r->buf + SNAP_HEADER_SIZE, size - SNAP_HEADER_SIZE) != sum)
+        return bad(r, "corrupted (checksum mismatch)"), NULL;
 
     carom_world_def def;
-    read_def(&r, &def);
-    double last_dt = get_f64(&r, "reserved f64"); /* was the last step's dt: read, checked, unused */
-    uint64_t steps = get_u64(&r, "step count");
-    if (r.failed) return NULL;
+    read_def(r, &def);
+    double last_dt = get_f64(r, "reserved f64"); /* was the last step's dt: read, checked, unused */
+    uint64_t steps = get_u64(r, "step count");
+    if (r->failed) return NULL;
     char why[WORLD_ERROR_SIZE];
-    if (carom_world_def_check(&def, why, sizeof why) != CAROM_OK) return bad(&r, "settings: %s", why), NULL;
+    if (carom_world_def_check(&def, why, sizeof why) != CAROM_OK) return bad(r, "settings: %s", why), NULL;
     /* written as 0 (it was the last step's dt): anything else would not
      * snapshot back to the same bytes */
-    if (last_dt != 0.0) return bad(&r, "reserved field after the settings is %g, not 0", last_dt), NULL;
-    if (steps >> 63) return bad(&r, "step count out of range"), NULL;
+    if (last_dt != 0.0) return bad(r, "reserved field after the settings is %g, not 0", last_dt), NULL;
+    if (steps >> 63) return bad(r, "step count out of range"), NULL;
     /* the storage hint is kept but not acted on: the store is sized for the
      * bodies the snapshot holds, never for a number the data merely claims */
     int capacity_hint = def.body_capacity;
     def.body_capacity = 0;
-    carom_world *w = carom_world_create(&def);
-    if (!w) return bad(&r, "out of memory"), NULL;
+    carom_world *w = r->into; /* (taken: destroyed below if the data is refused) */
+    r->into = NULL;
+    r->reuse = w != NULL;
+    if (!w) w = carom_world_create(&def);
+    if (!w) return no_memory(r), NULL;
+    if (r->reuse) {
+        clear_state(w);
+        w->def = def; /* (as carom_world_create keeps a checked def) */
+    }
     w->def.body_capacity = capacity_hint;
     w->stats.step_count = (long long)steps;
     int *class_of = NULL;
-    if (!read_bodies(&r, w, &class_of)) {
+    if (!read_bodies(r, w, &class_of)) {
         free(class_of);
         carom_world_destroy(w);
         return NULL;
     }
     body_store *s = &w->bodies;
-    int ok = read_contacts(&r, w, class_of) && read_sensor_overlaps(&r, w);
+    int ok = read_contacts(r, w, class_of) && read_sensor_overlaps(r, w);
     free(class_of);
     if (!ok) {
         carom_world_destroy(w);
         return NULL;
     }
-    if (r.pos != size) {
+    if (r->pos != size) {
         carom_world_destroy(w);
-        return bad(&r, "%zu bytes left over after the sensor overlaps", size - r.pos), NULL;
+        return bad(r, "%zu bytes left over after the sensor overlaps", size - r->pos), NULL;
     }
     /* the broadphase, built at once from the stored bounds (the trees' shape
      * does not change what it reports), with the moved set restored */
@@ -2270,7 +2401,7 @@ CAROM_API carom_world *carom_world_restore(const void *data, size_t size, char *
     free(is_static);
     if (!ok) {
         carom_world_destroy(w);
-        return bad(&r, "out of memory"), NULL;
+        return no_memory(r), NULL;
     }
     for (int i = 0; i < s->count; i++) {
         bp_set_moved(w->bp, s->proxy[i], s->solver_index[i]);

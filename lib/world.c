@@ -212,6 +212,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(s->tight_box); free(s->pose); free(s->touching); free(s->mixed);
     free(w->sensor_overlaps);
     free(s->new_pairs); free(s->asleep_pairs); free(s->toi); free(s->toi_bodies); free(s->toi_fast); free(s->toi_near); free(s->merged);
+    carom_world_destroy(w->spare);
     free(w);
 }
 

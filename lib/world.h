@@ -90,6 +90,8 @@ struct carom_world {
     char error[WORLD_ERROR_SIZE];
     int error_reason;           /* error + error_reason: the message without the failing function's name */
     carom_status last_status;   /* the status world_fail last recorded */
+    struct carom_world *spare;  /* carom_world_restore_into's other buffer: the state before the last
+                                   restore, its memory kept for the next (snapshot.c); NULL: none */
 };
 
 /* The angular speed clamp. max_angular_speed > 0 is the user's cap, honoured

@@ -22,6 +22,9 @@
 
 typedef struct snap { unsigned char *data; size_t size; } snap;
 
+/* Rewrites the header's checksum after a change (below). */
+static void fix_checksum(unsigned char *p, size_t n);
+
 static snap take(const carom_world *w)
 {
     snap s;
@@ -232,6 +235,129 @@ static void test_restore_continues_bitwise(void **state)
     (void)state;
     const char *presets[] = {"fast", "default", "accurate"};
     for (int p = 0; p < 3; p++) continue_bitwise(presets[p], 0);
+}
+
+static void count_event(void *context, const carom_contact_event *event)
+{
+    (void)event;
+    ++*(int *)context;
+}
+
+typedef struct locked_probe { carom_world *w; const snap *s; int tries; } locked_probe;
+
+static void restore_inside_step(void *context, const carom_contact_event *event)
+{
+    (void)event;
+    locked_probe *p = context;
+    assert_int_equal(carom_world_restore_into(p->w, p->s->data, p->s->size), CAROM_ERROR_LOCKED);
+    p->tries++;
+}
+
+/* carom_world_restore_into: a world restored into continues bit for bit as
+ * the snapshot's world (and as carom_world_restore's), whatever state it
+ * held before, again and again (the spare's memory reused); the host's event
+ * callback and the user data of the bodies the snapshot holds stay; a bad
+ * snapshot is refused with the reader's reason and leaves the world exactly
+ * as it was; inside the step it is LOCKED. */
+static void test_restore_into(void **state)
+{
+    (void)state;
+    int events = 0;
+    carom_world *a = mixed_scene("default", &events);
+    for (int s = 40; s < 137; s++) assert_int_equal(carom_world_step(a, 1.0 / 60), CAROM_OK);
+    snap s0 = take(a);
+    carom_world *other = mixed_scene("fast", &events); /* another state to restore from */
+    for (int s = 0; s < 30; s++) assert_int_equal(carom_world_step(other, 1.0 / 60), CAROM_OK);
+    snap s_other = take(other);
+    /* the target: an empty world with a callback and a body with user data */
+    carom_world_def wd = carom_world_def_default();
+    int called = 0;
+    wd.event_callback = count_event;
+    wd.event_context = &called;
+    carom_world *b = carom_world_create(&wd);
+    assert_non_null(b);
+    carom_body_id ids[64];
+    int n = carom_world_query_aabb(a, vec(-100, -100, -100), vec(100, 100, 100), ids, 64);
+    assert_true(n > 30);
+    int tag = 7;
+    char msg[256];
+    carom_world *c = carom_world_restore(s0.data, s0.size, msg, sizeof msg);
+    if (!c) fail_msg("restore: %s", msg);
+    for (int round = 0; round < 4; round++) {
+        /* another state in between (the spare then holds it) */
+        const snap *first = round % 2 ? &s_other : &s0;
+        assert_int_equal(carom_world_restore_into(b, first->data, first->size), CAROM_OK);
+        snap x = take(b);
+        assert_same_snap(*first, x, round);
+        free(x.data);
+        if (round == 1) assert_int_equal(carom_body_set_user_data(b, ids[3], &tag), CAROM_OK);
+        assert_int_equal(carom_world_restore_into(b, s0.data, s0.size), CAROM_OK);
+        x = take(b);
+        assert_same_snap(s0, x, round);
+        free(x.data);
+    }
+    assert_ptr_equal(carom_body_get_user_data(b, ids[3]), &tag); /* the same body in both states */
+    assert_null(carom_body_get_user_data(b, ids[4]));
+    /* bad snapshots: the reader's reason, the world unchanged */
+    unsigned char *bad_copy = malloc(s_other.size);
+    assert_non_null(bad_copy);
+    memcpy(bad_copy, s_other.data, s_other.size);
+    bad_copy[38] |= 0xf0; /* gravity x (the settings' first f64) made infinite or NaN */
+    bad_copy[39] |= 0x7f;
+    fix_checksum(bad_copy, s_other.size);
+    const void *bad_data[] = {s_other.data, bad_copy, NULL, "CAROMSNP"};
+    size_t bad_size[] = {s_other.size - 1, s_other.size, 10, 8};
+    for (int k = 0; k < 4; k++) {
+        carom_status st = carom_world_restore_into(b, bad_data[k], bad_size[k]);
+        assert_int_equal(st, CAROM_ERROR_INVALID_ARGUMENT);
+        assert_true(strncmp(carom_world_last_error(b), "world_restore_into: snapshot: ", 30) == 0);
+        snap x = take(b);
+        assert_same_snap(s0, x, -k);
+        free(x.data);
+    }
+    print_message("refused: %s\n", carom_world_last_error(b));
+    assert_int_equal(carom_world_restore_into(NULL, s0.data, s0.size), CAROM_ERROR_INVALID_ARGUMENT);
+    /* and it steps on as carom_world_restore's world and the original do */
+    for (int step = 138; step < 137 + 300; step++) {
+        assert_int_equal(carom_world_step(a, 1.0 / 60), CAROM_OK);
+        assert_int_equal(carom_world_step(b, 1.0 / 60), CAROM_OK);
+        assert_int_equal(carom_world_step(c, 1.0 / 60), CAROM_OK);
+        assert_same_events(a, b, step);
+        snap x = take(a), y = take(b), z = take(c);
+        assert_same_snap(x, y, step);
+        assert_same_snap(x, z, step);
+        free(x.data);
+        free(y.data);
+        free(z.data);
+    }
+    assert_true(called > 20); /* the host's callback kept */
+    /* inside the step */
+    carom_world_def wl = carom_world_def_default();
+    locked_probe probe = {NULL, &s0, 0};
+    wl.event_callback = restore_inside_step;
+    wl.event_context = &probe;
+    carom_world *l = carom_world_create(&wl);
+    probe.w = l;
+    assert_int_equal(carom_world_restore_into(l, s0.data, s0.size), CAROM_OK);
+    for (int s = 0; s < 10; s++) assert_int_equal(carom_world_step(l, 1.0 / 60), CAROM_OK);
+    assert_true(probe.tries > 0);
+    snap after = take(l);
+    carom_world *l2 = carom_world_restore(s0.data, s0.size, msg, sizeof msg);
+    for (int s = 0; s < 10; s++) assert_int_equal(carom_world_step(l2, 1.0 / 60), CAROM_OK);
+    snap ref = take(l2);
+    assert_same_snap(ref, after, 10); /* the refused calls changed nothing */
+    free(after.data);
+    free(ref.data);
+    carom_world_destroy(l2);
+    print_message("restore_into: %d events reached the kept callback, %d refused inside the step\n", called, probe.tries);
+    free(bad_copy);
+    free(s0.data);
+    free(s_other.data);
+    carom_world_destroy(l);
+    carom_world_destroy(a);
+    carom_world_destroy(b);
+    carom_world_destroy(c);
+    carom_world_destroy(other);
 }
 
 static void test_empty_world_and_errors(void **state)
@@ -865,6 +991,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_empty_world_and_errors),
         cmocka_unit_test(test_restore_continues_bitwise),
+        cmocka_unit_test(test_restore_into),
         cmocka_unit_test(test_bad_snapshots_refused),
         cmocka_unit_test(test_reads_format_7),
         cmocka_unit_test(test_truncated_body_records_named),

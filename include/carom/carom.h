@@ -882,6 +882,19 @@ CAROM_API carom_status carom_compound_check(const carom_compound_child *children
 CAROM_API carom_status carom_fixed_step(double dt, int max_steps, double frame_time, double *accumulator, int *steps,
                                         char *msg, size_t msg_size);
 
+/* ---- restoring into a world ---------------------------------------------- */
+
+/* carom_world_restore into an existing world (rollback networking restores
+ * every frame): the world becomes the snapshot's, and continues bit for bit
+ * as the snapshot's world would have. The host's settings stay: the event
+ * callback and its context, the task hooks and worker count, the pair
+ * filter and pre-solve callbacks, and the user data of every body the
+ * snapshot also holds (the same id, index and generation); the last step's
+ * events are gone. A snapshot carom_world_restore refuses is refused with
+ * its reason (INVALID_ARGUMENT; OUT_OF_MEMORY; LOCKED inside the step) and
+ * the world is left exactly as it was. */
+CAROM_API carom_status carom_world_restore_into(carom_world *world, const void *data, size_t size);
+
 #ifdef __cplusplus
 }
 #endif
