@@ -231,6 +231,44 @@ static int l_restore(lua_State *L)
     return 1;
 }
 
+/* world:restore(s): this world becomes the state in world:snapshot()'s
+ * string (carom_world_restore_into), continuing bit for bit as the
+ * snapshotted world would have; it keeps its contact callback, threads and
+ * advance() settings, and the user_data of the bodies the snapshot also
+ * holds (the same id). Raises on a string that is not a whole snapshot, and
+ * the world is then unchanged. */
+static int world_restore(lua_State *L)
+{
+    clua_world *lw = clua_check_world(L, 1, "restore");
+    if (lw->stepping) return luaL_error(L, "restore: cannot restore a world inside its own contact callback");
+    if (lua_type(L, 2) != LUA_TSTRING) return clua_type_error(L, 2, "restore", "string (from world:snapshot())");
+    size_t n;
+    const char *data = lua_tolstring(L, 2, &n);
+    lua_settop(L, 2);
+    lua_newtable(L); /* 3: the new ids (made before the world changes: memory errors raise first) */
+    lua_newtable(L); /* 4: the new user data */
+    if (carom_world_restore_into(lw->world, data, n) != CAROM_OK)
+        return clua_arg_error(L, 2, "restore", "%s", carom_world_last_error_reason(lw->world));
+    int count = carom_world_body_count(lw->world);
+    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(count > 0 ? count : 1), 0); /* 5 */
+    carom_vec3 lo = {-1e300, -1e300, -1e300}, hi = {1e300, 1e300, 1e300};
+    int found = carom_world_query_aabb(lw->world, lo, hi, ids, count);
+    lua_getiuservalue(L, 1, WORLD_UV_DATA); /* 6: the old user data */
+    for (int i = 0; i < found && i < count; i++) {
+        lua_Integer key = (lua_Integer)carom_body_id_pack(ids[i]);
+        lua_pushboolean(L, 1);
+        lua_rawseti(L, 3, key);
+        if (lua_rawgeti(L, 6, key) != LUA_TNIL) lua_rawseti(L, 4, key);
+        else lua_pop(L, 1);
+    }
+    lua_pushvalue(L, 3);
+    lua_setiuservalue(L, 1, WORLD_UV_IDS);
+    lua_pushvalue(L, 4);
+    lua_setiuservalue(L, 1, WORLD_UV_DATA);
+    lua_settop(L, 1);
+    return 1;
+}
+
 /* world:configure{options}: the same keys as carom.world, applied between steps. */
 static int world_configure(lua_State *L)
 {
@@ -686,7 +724,7 @@ void clua_open_world(lua_State *L)
         {"ray_cast", world_ray_cast}, {"query_aabb", world_query_aabb}, {"bodies", world_bodies},
         {"body_count", world_body_count}, {"configure", world_configure}, {"settings", world_settings},
         {"set_contact_callback", world_set_contact_callback}, {"is_valid", world_is_valid},
-        {"destroy", world_destroy}, {"snapshot", world_snapshot}, {NULL, NULL}};
+        {"destroy", world_destroy}, {"snapshot", world_snapshot}, {"restore", world_restore}, {NULL, NULL}};
     static const luaL_Reg meta[] = {{"__gc", world_gc}, {"__close", world_close}, {"__tostring", world_tostring},
                                     {NULL, NULL}};
     luaL_newmetatable(L, CLUA_WORLD_MT);

@@ -101,6 +101,36 @@ test("a restored world's bodies are its own: positions, destroy, callbacks", fun
   assert(b:body_count() == #bb - 1)
 end)
 
+test("world:restore(s) makes a world the snapshot's, again and again, and refuses bad strings", function()
+  local a = mixed_scene("default")
+  for _ = 41, 137 do a:step(1 / 60) end
+  local s = a:snapshot()
+  local other = mixed_scene("fast"):snapshot()
+  local b = mixed_scene("fast")
+  local calls = 0
+  b:set_contact_callback(function() calls = calls + 1 end)
+  local kept = b:bodies()[4]
+  kept.user_data = "kept"
+  for round = 1, 3 do
+    assert(b:restore(round == 2 and other or s) == b)
+    assert(b:snapshot() == (round == 2 and other or s))
+  end
+  assert(b:body_count() == a:body_count() and #b:bodies() == a:body_count())
+  assert(kept.user_data == "kept", "the user_data of a body in both states was lost")
+  for _, bad in ipairs{ other:sub(1, #other - 1), "hello", other:sub(1, 8) .. "\9" .. other:sub(10) } do
+    raises("snapshot: ", b.restore, b, bad)
+    assert(b:snapshot() == s, "a refused snapshot changed the world")
+  end
+  raises("string (from world:snapshot()) expected, got number", b.restore, b, 42)
+  for step = 138, 237 do
+    a:step(1 / 60)
+    b:step(1 / 60)
+    same_events(a, b, step)
+    assert(a:snapshot() == b:snapshot(), "snapshots differ after step " .. step)
+  end
+  assert(calls > 0, "the kept contact callback never ran")
+end)
+
 test("bad snapshots raise a clear error", function()
   local s = mixed_scene("fast"):snapshot()
   raises("string (from world:snapshot()) expected, got number", carom.restore, 42)
