@@ -77,13 +77,22 @@ enum {
     STEP_FREE_SPIN = 16,   /* dynamic, unlocked, anisotropic: the midpoint rotation (rotation.c) */
     STEP_KINEMATIC = 32    /* inv_mass 0: turned by the exact exponential map */
 };
+enum { STEP_EXTRA = STEP_TORQUE | STEP_LINEAR_DAMP | STEP_ANGULAR_DAMP | STEP_FREE_SPIN };
 typedef struct body_step {
     int flags;             /* the fields below are set only where a flag says they are read */
+    int extra;             /* its body_step_extra in solver_memory.motion_extra; a STEP_EXTRA flag */
     vec3 acc;              /* gravity (scaled) and force over mass; not STEP_KINEMATIC */
+} body_step;
+/* What only some bodies' sub-steps read (most bodies have no torque, no
+ * damping and an isotropic inertia: kept for every body, these were 112 B
+ * a body, 5.6 MB at 50,000 bodies). */
+typedef struct body_step_extra {
+    mat3 inertia_start;    /* the step's starting world inertia, the inverse of B->inv_inertia: L = I w
+                              (STEP_FREE_SPIN; finish_bodies computes the other bodies') */
     vec3 spin;             /* I^-1 torque at the step's inertia; STEP_TORQUE */
     double linear_keep;    /* 1 / (1 + h linear_damping); STEP_LINEAR_DAMP */
     double angular_keep;   /* 1 / (1 + h angular_damping); STEP_ANGULAR_DAMP */
-} body_step;
+} body_step_extra;
 
 /* Keeps plane-locked bodies in their plane: in-plane velocity, spin about the normal. */
 static void project_planar(const carom_world *w, const step_context *ctx)
@@ -157,11 +166,13 @@ static int compute_levels(contact_constraint *cc, int n, const impulse_body *bod
 
 /* ---- the stages ---------------------------------------------------------- */
 
-static void body_step_of(const body_store *bs, int i, const impulse_body *B, const step_context *ctx, body_step *m)
+/* Fills m, and x when it returns 1: the body has a STEP_EXTRA flag. */
+static int body_step_of(const body_store *bs, int i, const impulse_body *B, const step_context *ctx, body_step *m,
+                        body_step_extra *x)
 {
     if (B->inv_mass == 0.0) {
         m->flags = STEP_KINEMATIC;
-        return;
+        return 0;
     }
     double h = ctx->h;
     int flags = 0;
@@ -169,22 +180,26 @@ static void body_step_of(const body_store *bs, int i, const impulse_body *B, con
     uint32_t bf = bs->flags[i];
     if (bf & BODY_HAS_FORCE) {
         flags |= STEP_TORQUE;
-        m->spin = m3_mulv(B->inv_inertia, bs->torque[i]);
+        x->spin = m3_mulv(B->inv_inertia, bs->torque[i]);
     }
     double ld = bs->linear_damping[i], ad = bs->angular_damping[i];
     if (ld > 0) {
         flags |= STEP_LINEAR_DAMP;
-        m->linear_keep = 1.0 / (1.0 + h * ld);
+        x->linear_keep = 1.0 / (1.0 + h * ld);
     } else {
         flags |= STEP_FLIGHT;
     }
     if (ad > 0) {
         flags |= STEP_ANGULAR_DAMP;
-        m->angular_keep = 1.0 / (1.0 + h * ad);
+        x->angular_keep = 1.0 / (1.0 + h * ad);
     }
-    if (!(bf & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION)) && !rotation_is_isotropic(&bs->inv_inertia_local[i]))
+    if (!(bf & (BODY_LOCK_PLANE | BODY_LOCK_ROTATION)) && !rotation_is_isotropic(&bs->inv_inertia_local[i])) {
         flags |= STEP_FREE_SPIN;
+        /* once per step, not per sub-step: integrate_rotation's L = I w */
+        x->inertia_start = m3_inverse(B->inv_inertia);
+    }
     m->flags = flags;
+    return (flags & STEP_EXTRA) != 0;
 }
 
 /* Awake bodies, contiguous: index 0 is the shared immovable body. */
@@ -214,9 +229,6 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     void *p3 = realloc(s->delta_rotation, sizeof *s->delta_rotation * (size_t)cap);
     if (!p3) return 0;
     s->delta_rotation = p3;
-    void *p4 = realloc(s->inertia_start, sizeof *s->inertia_start * (size_t)cap);
-    if (!p4) return 0;
-    s->inertia_start = p4;
     if (!array_reserve_near(&s->solver.motion, &s->solver.motion_capacity, cap, sizeof(body_step))) return 0;
     body_step *motion = s->solver.motion;
     motion[0].flags = STEP_KINEMATIC;
@@ -225,7 +237,7 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
     s->delta_position[0] = v3_zero();
     s->delta_rotation[0] = v3_zero();
     s->body_slot[0] = -1;
-    int nb = 1;
+    int nb = 1, extra_count = 0;
     uint32_t any_flags = 0;
     for (int i = 0; i < bs->count; i++) {
         if (bs->type[i] == CAROM_BODY_STATIC || !(bs->flags[i] & BODY_AWAKE)) continue;
@@ -238,11 +250,16 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
         bodies[k].w = clamp_length(bs->angular_velocity[i], wmax, &work->clamped);
         bodies[k].inv_mass = bs->inv_mass[i];
         bodies[k].inv_inertia = bs->inv_inertia_world[i];
-        /* once per step, not per sub-step: integrate_rotation's L = I w */
-        s->inertia_start[k] = m3_inverse(bodies[k].inv_inertia);
         s->delta_position[k] = v3_zero();
         s->delta_rotation[k] = v3_zero();
-        body_step_of(bs, i, &bodies[k], ctx, &motion[k]);
+        body_step_extra x;
+        if (body_step_of(bs, i, &bodies[k], ctx, &motion[k], &x)) {
+            if (!array_reserve_near(&s->solver.motion_extra, &s->solver.motion_extra_capacity, extra_count + 1,
+                                    sizeof(body_step_extra)))
+                return 0;
+            motion[k].extra = extra_count;
+            ((body_step_extra *)s->solver.motion_extra)[extra_count++] = x;
+        }
         any_flags |= bs->flags[i];
     }
     s->solver.planar = (any_flags & BODY_LOCK_PLANE) != 0;
@@ -873,6 +890,7 @@ static void integrate_velocities_range(int begin, int end, int worker, void *p)
     const body_job *j = p;
     const step_context *ctx = j->ctx;
     const body_step *motion = j->w->scratch.solver.motion;
+    const body_step_extra *extra = j->w->scratch.solver.motion_extra;
     double h = ctx->h;
     (void)worker;
     for (int b = 1 + begin; b < 1 + end; b++) {
@@ -880,10 +898,12 @@ static void integrate_velocities_range(int begin, int end, int worker, void *p)
         if (m->flags & STEP_KINEMATIC) continue;
         impulse_body *B = &ctx->bodies[b];
         B->v = v3_madd(B->v, h, m->acc);
+        if (!(m->flags & (STEP_TORQUE | STEP_LINEAR_DAMP | STEP_ANGULAR_DAMP))) continue;
+        const body_step_extra *x = &extra[m->extra];
         /* a torque adds tau h to the angular momentum: w = I_start^-1 L as the solver keeps it */
-        if (m->flags & STEP_TORQUE) B->w = v3_madd(B->w, h, m->spin);
-        if (m->flags & STEP_LINEAR_DAMP) B->v = v3_scale(B->v, m->linear_keep);
-        if (m->flags & STEP_ANGULAR_DAMP) B->w = v3_scale(B->w, m->angular_keep);
+        if (m->flags & STEP_TORQUE) B->w = v3_madd(B->w, h, x->spin);
+        if (m->flags & STEP_LINEAR_DAMP) B->v = v3_scale(B->v, x->linear_keep);
+        if (m->flags & STEP_ANGULAR_DAMP) B->w = v3_scale(B->w, x->angular_keep);
     }
 }
 
@@ -968,6 +988,7 @@ static void integrate_positions_range(int begin, int end, int worker, void *p)
     body_store *bs = &j->w->bodies;
     const step_context *ctx = j->ctx;
     const body_step *motion = j->w->scratch.solver.motion;
+    const body_step_extra *extra = j->w->scratch.solver.motion_extra;
     const int *in_contact = j->work->in_contact;
     double h = ctx->h;
     (void)worker;
@@ -986,7 +1007,8 @@ static void integrate_positions_range(int begin, int end, int worker, void *p)
         if (B->w.x != 0.0 || B->w.y != 0.0 || B->w.z != 0.0) {
             vec3 wr = B->w;
             if (m->flags & (STEP_FREE_SPIN | STEP_KINEMATIC))
-                wr = integrate_rotation(bs, slot, B, m->flags, &j->w->scratch.inertia_start[b], h);
+                wr = integrate_rotation(bs, slot, B, m->flags,
+                                        m->flags & STEP_FREE_SPIN ? &extra[m->extra].inertia_start : NULL, h);
             else
                 bs->rotation[slot] = q_integrate(bs->rotation[slot], wr, h);
             ctx->dq[b] = v3_madd(ctx->dq[b], h, wr);
@@ -1175,6 +1197,8 @@ static void finish_bodies_range(int begin, int end, int worker, void *p)
     int *clamped = &job->clamped[worker], *non_finite = &job->non_finite[worker];
     body_store *bs = &w->bodies;
     double vmax = w->def.max_linear_speed, wmax = world_spin_clamp(&w->def, ctx->h);
+    const body_step *motion = w->scratch.solver.motion;
+    const body_step_extra *extra = w->scratch.solver.motion_extra;
     for (int b = 1 + begin; b < 1 + end; b++) {
         int slot = ctx->body_slot[b];
         const impulse_body *B = &ctx->bodies[b];
@@ -1202,7 +1226,12 @@ static void finish_bodies_range(int begin, int end, int worker, void *p)
             /* the solver worked with the step's starting inertia; carry its angular
              * momentum L = I_start w to the new orientation (w = I_end^-1 L), so a
              * freely tumbling body conserves L rather than w */
-            vec3 L = m3_mulv(w->scratch.inertia_start[b], av);
+            const body_step *m = &motion[b];
+            /* L = I_start w: the inverse of the step's starting B->inv_inertia, kept
+             * by gather_bodies for the bodies whose sub-steps read it */
+            mat3 inertia = m->flags & STEP_FREE_SPIN ? extra[m->extra].inertia_start
+                                                     : m3_inverse(B->inv_inertia);
+            vec3 L = m3_mulv(inertia, av);
             body_update_inertia(bs, slot);
             av = m3_mulv(bs->inv_inertia_world[slot], L);
             if (bs->flags[slot] & BODY_LOCK_PLANE) av = v3_scale(bs->plane_normal[slot], v3_dot(av, bs->plane_normal[slot]));
@@ -1253,6 +1282,7 @@ void solver_memory_free(solver_memory *m)
     free(m->last_order);
     free(m->mark);
     free(m->motion);
+    free(m->motion_extra);
     column_memory_free(&m->columns);
     memset(m, 0, sizeof *m);
 }

@@ -32,6 +32,8 @@ typedef struct solver_memory {
     int last_count, last_capacity, mark_capacity;
     void *motion;                /* per solver body: what its sub-steps read of it (body_step, solver.c) */
     int motion_capacity;
+    void *motion_extra;          /* what only some bodies' sub-steps read (body_step_extra, solver.c) */
+    int motion_extra_capacity;
     int bodies_capacity;         /* step_scratch.bodies' (gather_bodies) */
     int planar;                  /* this step: some awake body is locked to a plane */
     int rotation_locked;         /* this step: some awake body is rotation-locked (spinless manifolds may exist) */

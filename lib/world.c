@@ -205,7 +205,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     free(w->events.items);
     free(w->events.children);
     step_scratch *s = &w->scratch;
-    free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->inertia_start); free(s->body_slot);
+    free(s->bodies); free(s->delta_position); free(s->delta_rotation); free(s->body_slot);
     solver_memory_free(&s->solver);
     impact_memory_free(&s->impact);
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);

@@ -30,8 +30,6 @@ typedef struct step_scratch {
     impulse_body *bodies;       /* solver bodies: index 0 is the shared static body */
     vec3 *delta_position;       /* per solver body, since the start of the step */
     vec3 *delta_rotation;       /* accumulated rotation vector (small-angle) */
-    mat3 *inertia_start;        /* per solver body: the step's starting world inertia,
-                                   the inverse of bodies[k].inv_inertia (L = I w) */
     int *body_slot;             /* solver body -> store slot */
     int body_capacity;
     solver_memory solver;       /* solver.c's constraints and batches */
