@@ -518,7 +518,7 @@ int world_continuous(carom_world *w, const step_context *step)
             ctx.near_count = 0;
             bp_query(w->bp, box, collect_near, &ctx);
             if (ctx.failed) return 0;
-            world_rank_sort(s, ctx.near, ctx.near + ctx.near_count, ctx.near_count);
+            if (ctx.near_count > 1) world_rank_sort(s, ctx.near, ctx.near + ctx.near_count, ctx.near_count); /* (none near: ctx.near may be NULL) */
             for (int j = 0; j < ctx.near_count; j++) sweep_against(&ctx, ctx.near[j]);
             if (ctx.failed) return 0;
         }
