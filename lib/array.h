@@ -3,6 +3,7 @@
 #define CAROM_ARRAY_H
 
 #include <stdlib.h>
+#include "pages.h"
 
 /* Makes *items hold at least `need` elements of `elem` bytes (doubling from 64).
  * Returns 0 on out of memory, leaving the array as it was. */
@@ -13,6 +14,7 @@ static inline int array_reserve(void **items, int *capacity, int need, size_t el
     while (n < need) n *= 2;
     void *p = realloc(*items, elem * (size_t)n);
     if (!p) return 0;
+    pages_hint_huge(p, elem * (size_t)n);
     *items = p;
     *capacity = n;
     return 1;
@@ -31,6 +33,7 @@ static inline int array_reserve_near(void **items, int *capacity, int need, size
     if (n < need) n = need; /* (overflow) */
     void *p = realloc(*items, elem * (size_t)n);
     if (!p) return 0;
+    pages_hint_huge(p, elem * (size_t)n);
     *items = p;
     *capacity = n;
     return 1;

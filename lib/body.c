@@ -2,6 +2,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "body.h"
+#include "pages.h"
 
 /* Every dense array, so growth and swap-removal treat them uniformly. */
 #define BODY_FIELDS(X) \
@@ -16,6 +17,7 @@ static int grow_field(void **p, size_t elem, int new_cap)
 {
     void *n = realloc(*p, elem * (size_t)new_cap);
     if (!n) return 0;
+    pages_hint_huge(n, elem * (size_t)new_cap);
     *p = n;
     return 1;
 }

@@ -219,15 +219,18 @@ static int gather_bodies(carom_world *w, step_context *ctx, solver_work *work)
          * into a page, which split every one of them over two */
         void *p1 = NULL;
         if (posix_memalign(&p1, 64, sizeof *s->bodies * (size_t)cap) != 0) return 0;
+        pages_hint_huge(p1, sizeof *s->bodies * (size_t)cap);
         free(s->bodies);
         s->bodies = p1;
         s->solver.bodies_capacity = cap;
     }
     void *p2 = realloc(s->delta_position, sizeof *s->delta_position * (size_t)cap);
     if (!p2) return 0;
+    pages_hint_huge(p2, sizeof *s->delta_position * (size_t)cap);
     s->delta_position = p2;
     void *p3 = realloc(s->delta_rotation, sizeof *s->delta_rotation * (size_t)cap);
     if (!p3) return 0;
+    pages_hint_huge(p3, sizeof *s->delta_rotation * (size_t)cap);
     s->delta_rotation = p3;
     if (!array_reserve_near(&s->solver.motion, &s->solver.motion_capacity, cap, sizeof(body_step))) return 0;
     body_step *motion = s->solver.motion;

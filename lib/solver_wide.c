@@ -22,6 +22,7 @@
 #include <string.h>
 #include "solver_wide.h"
 #include "tasks.h"
+#include "pages.h"
 
 #define LANES 4
 
@@ -292,6 +293,7 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc
         while (cap < bytes) cap *= 2;
         void *p = realloc(*mem, cap + 63);
         if (!p) return NULL;
+        pages_hint_huge(p, cap + 63);
         *mem = p;
         *capacity = cap;
     }
