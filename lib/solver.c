@@ -807,7 +807,8 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
     if (!s->solver.wide_env) s->solver.wide_env = wide_read_env(); /* once per world, not a getenv a step */
     work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count,
-                           work->locked > 0 || s->solver.rotation_locked, ctx->body_count, s->solver.wide_env);
+                           work->locked > 0 || s->solver.rotation_locked, ctx->body_count, s->solver.wide_env,
+                           ctx->tasks);
     if (!work->wide) return 0;
     work->scalar_count = wide_overflow(work->wide, &work->scalar);
     return 1;
@@ -1074,7 +1075,7 @@ static void relax(carom_world *w, const step_context *ctx, const solver_work *wo
 
 static void store_wide(const step_context *ctx, const solver_work *work)
 {
-    if (work->wide) wide_store(work->wide, ctx->constraints);
+    if (work->wide) wide_store(work->wide, ctx->constraints, ctx);
 }
 
 /* Before any body moved: 0 (error set) when an explicit penalty spring

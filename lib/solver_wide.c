@@ -328,7 +328,9 @@ static wide_set *reserve_set(void **mem, size_t *capacity, const plan_counts *pc
 }
 
 /* Greedy colouring; the static body 0 never blocks (it does not move).
- * bucket[k]: constraint k's bucket (BUCKET), or -1: the scalar passes. */
+ * bucket[k]: constraint k's bucket (BUCKET), or -1: the scalar passes; a
+ * coloured constraint's wide_lane holds its place in its bucket until
+ * fill_lanes, which then needs no count of its own (and runs in ranges). */
 static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int kinds, int *bucket, uint32_t *used,
                             plan_buckets *pb)
 {
@@ -348,7 +350,7 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
         if (a) used[a] |= 1u << c;
         if (b) used[b] |= 1u << c;
         bucket[k] = BUCKET(c, kinds ? kind_of(&cc[k]) : 0, cc[k].count);
-        pb->count[bucket[k]]++;
+        cc[k].wide_lane = pb->count[bucket[k]]++;
     }
 }
 
@@ -385,6 +387,7 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *p
                         }
                     }
                     wb->count = n;
+                    wb->lanes = i < batches - 1 || pb->count[bk] % LANES == 0 ? LANES : pb->count[bk] % LANES;
                     wb->first = first;
                     wb->kind = kind;
                     wb->lock = -1;
@@ -400,7 +403,6 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *p
                 if (spinless) nlin += batches * n;
                 else if (planar) nplan += batches * n;
                 else nwide += batches * n;
-                pb->count[bk] = 0; /* now: lanes filled so far */
             }
         }
     }
@@ -408,19 +410,38 @@ static void lay_out_batches(wide_set *ws, plan_buckets *pb, const plan_counts *p
     ws->batch_count = nbatch;
 }
 
-/* Each coloured manifold into the next free lane of its bucket's batches. */
-static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int *bucket, plan_buckets *pb)
+/* Each coloured manifold into its lane (its place in its bucket, from
+ * color_manifolds): the manifolds write only their own lanes, so in ranges. */
+typedef struct lanes_job {
+    wide_set *ws;
+    contact_constraint *cc;
+    const int *bucket;
+    const plan_buckets *pb;
+} lanes_job;
+
+static void fill_lanes_range(int begin, int end, int worker, void *p)
 {
-    for (int k = 0; k < ncon; k++) {
-        int bk = bucket[k];
+    const lanes_job *j = p;
+    (void)worker;
+    for (int k = begin; k < end; k++) {
+        int bk = j->bucket[k];
         if (bk < 0) continue;
-        int slot = pb->count[bk]++;
-        wide_batch *wb = &ws->batches[pb->start[bk] + slot / LANES];
-        fill_header(ws, wb, slot % LANES, k, &cc[k]);
-        wb->lanes = slot % LANES + 1;
-        cc[k].wide_batch = pb->start[bk] + slot / LANES;
-        cc[k].wide_lane = slot % LANES;
+        contact_constraint *c = &j->cc[k];
+        int slot = c->wide_lane, batch = j->pb->start[bk] + slot / LANES;
+        fill_header(j->ws, &j->ws->batches[batch], slot % LANES, k, c);
+        c->wide_batch = batch;
+        c->wide_lane = slot % LANES;
     }
+}
+
+/* Manifolds per range of fill_lanes. */
+#define LANES_MIN_RANGE 256
+
+static void fill_lanes(wide_set *ws, contact_constraint *cc, int ncon, const int *bucket, const plan_buckets *pb,
+                       const carom_world_def *tasks)
+{
+    lanes_job j = {ws, cc, bucket, pb};
+    tasks_run(tasks, ncon, LANES_MIN_RANGE, fill_lanes_range, &j);
 }
 
 int wide_read_env(void)
@@ -431,7 +452,8 @@ int wide_read_env(void)
     return env;
 }
 
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env)
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env,
+                    const carom_world_def *tasks)
 {
     int *color;
     uint32_t *used;
@@ -458,7 +480,7 @@ wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int nc
     lay_out_batches(ws, &pb, &pc);
     ws->free_only = 1;
     for (int kind = 1; kind < WIDE_KINDS; kind++) ws->free_only &= pc.manifolds[kind] == 0;
-    fill_lanes(ws, cc, ncon, color, &pb);
+    fill_lanes(ws, cc, ncon, color, &pb, tasks);
 #if WIDE_AVX2
     /* CAROM_NO_AVX2 set: the SSE2 build (tests compare the two bit for bit) */
     ws->avx2 = __builtin_cpu_supports("avx2") != 0 && !(env & WIDE_ENV_NO_AVX2);
@@ -2051,6 +2073,10 @@ void wide_read_impulses(const wide_set *ws, contact_constraint *c)
     }
 }
 
+/* Batches per range of the store: a batch's store is some 20 scattered
+ * writes, far less than a solve pass's work on it. */
+#define WIDE_STORE_MIN_RANGE 128
+
 /* One batch's points of either layout back to its constraints' points. */
 #define STORE_POINTS(PTS)                                                                          \
     for (int l = 0; l < wb->lanes; l++) {                                                          \
@@ -2065,13 +2091,23 @@ void wide_read_impulses(const wide_set *ws, contact_constraint *c)
         }                                                                                          \
     }
 
-void wide_store(const wide_set *ws, contact_constraint *cc)
+typedef struct store_job {
+    const wide_set *ws;
+    contact_constraint *cc;
+} store_job;
+
+/* Each batch writes only its own constraints' points: every batch at once. */
+static void store_range(int begin, int end, int worker, void *p)
 {
+    const store_job *j = p;
+    const wide_set *ws = j->ws;
+    contact_constraint *cc = j->cc;
     const wide_point *wide_point_array = ws->points;
     const wide_cpoint *wide_cpoint_array = ws->cpoints;
     const wide_lpoint *wide_lpoint_array = ws->lpoints;
     const wide_ppoint *wide_ppoint_array = ws->ppoints;
-    for (int k = 0; k < ws->batch_count; k++) {
+    (void)worker;
+    for (int k = begin; k < end; k++) {
         const wide_batch *wb = &ws->batches[k];
         if (wb->kind & WIDE_KIND_SPINLESS) {
             STORE_POINTS(wide_lpoint)
@@ -2083,4 +2119,10 @@ void wide_store(const wide_set *ws, contact_constraint *cc)
             STORE_POINTS(wide_point)
         }
     }
+}
+
+void wide_store(const wide_set *ws, contact_constraint *cc, const step_context *ctx)
+{
+    store_job j = {ws, cc};
+    tasks_run(ctx->tasks, ws->batch_count, WIDE_STORE_MIN_RANGE, store_range, &j);
 }

@@ -17,9 +17,10 @@ int wide_read_env(void);
  * needed), setting each constraint's wide_batch and wide_lane (-1: scalar)
  * and filling the batch headers; manifolds with a plane-locked body
  * (locked) or with no body that can turn (spinless) get batches of their
- * own (kinds 0: the caller knows there are none); env: wide_read_env's.
- * NULL on out of memory. */
-wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env);
+ * own (kinds 0: the caller knows there are none); env: wide_read_env's;
+ * tasks: the hooks the headers are filled through. NULL on out of memory. */
+wide_set *wide_plan(void **mem, size_t *capacity, contact_constraint *cc, int ncon, int kinds, int nb, int env,
+                    const carom_world_def *tasks);
 /* The constraints left to the scalar passes, in order. */
 int wide_overflow(const wide_set *ws, const int **list);
 /* Prepares every batched manifold's points four lanes at a time, as
@@ -32,7 +33,8 @@ void wide_solve(const wide_set *ws, const step_context *ctx, int use_bias, int h
 /* Copies a batched constraint's current impulses to its scalar points (the
  * shock pass reads them between wide passes). */
 void wide_read_impulses(const wide_set *ws, contact_constraint *c);
-/* Writes the batches' impulses back to the constraints' points. */
-void wide_store(const wide_set *ws, contact_constraint *cc);
+/* Writes the batches' impulses back to the constraints' points (in ranges
+ * of batches through the task hooks: a constraint is in one batch). */
+void wide_store(const wide_set *ws, contact_constraint *cc, const step_context *ctx);
 
 #endif
