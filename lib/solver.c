@@ -61,6 +61,7 @@ typedef struct solver_work {
     double max_penetration;
     int points;
     int locked;                  /* constraints with a plane-locked body */
+    int heavy_on_light;          /* some constraint's bodies differ in mass by SHOCK_MASS_RATIO or more */
     int stiff;                   /* scalar manifolds marked stiff (contact_block.stiff) */
     column_memory *columns;      /* the columns solved directly (column_solve.c) */
 } solver_work;
@@ -419,13 +420,41 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
 /* Constraints per range handed to the task hooks. */
 #define CONSTRAINT_MIN_RANGE 128
 
+/* What the later stages count over the new constraints, taken while each
+ * is in the cache: integer sums and an or, added per worker as a range
+ * ends, so any split gives the same totals. */
+typedef struct constraint_totals {
+    int extras;  /* with a plane-locked body or rolling resistance (attach_extras) */
+    int locked;  /* with a plane-locked body */
+    int shock;   /* some heavy-on-light pair (plan_shock) */
+} constraint_totals;
+
 /* A per-constraint loop's job. */
 typedef struct constraint_job {
     carom_world *w;
     const step_context *ctx;
     contact_constraint *cc;
-    solver_work *work;
+    int *in_contact; /* per solver body, zeroed before: set for each constraint's bodies */
+    constraint_totals totals[CAROM_MAX_WORKERS];
 } constraint_job;
+
+/* One body heavier than the other by SHOCK_MASS_RATIO or more. */
+static int heavy_on_light(const impulse_body *bodies, const contact_constraint *c)
+{
+    double ia = bodies[c->a].inv_mass, ib = bodies[c->b].inv_mass;
+    return (ia > 0 && ib >= SHOCK_MASS_RATIO * ia) || (ib > 0 && ia >= SHOCK_MASS_RATIO * ib);
+}
+
+/* Ranges running at once may mark one body: the same value, stored
+ * atomically where the compiler allows (so no data race). */
+static inline void mark_in_contact(int *flag)
+{
+#if defined(__GNUC__)
+    __atomic_store_n(flag, 1, __ATOMIC_RELAXED);
+#else
+    *flag = 1;
+#endif
+}
 
 /* What fill_constraint reads, fetched ahead in stages (the manifolds come
  * bottom-up, not in the contact set's or the bodies' order, so each of its
@@ -489,17 +518,29 @@ PREFETCH_INLINE void prefetch_constraint_inputs(const carom_world *w, const step
 /* Each constraint from its own manifold (its points already placed). */
 static void fill_constraints_range(int begin, int end, int worker, void *p)
 {
-    const constraint_job *j = p;
+    constraint_job *j = p;
     const int *touching = j->w->scratch.touching;
+    const impulse_body *bodies = j->ctx->bodies;
+    int *in_contact = j->in_contact;
     load_softness ls;
     load_softness_init(&ls, j->ctx);
-    (void)worker;
+    constraint_totals t = {0, 0, 0};
     /* one loop, one call: fill_constraint stays inlined as it was */
     int prefetch = j->w->scratch.touching_count >= PREFETCH_MIN_CONSTRAINTS;
     for (int k = begin; k < end; k++) {
         if (prefetch) prefetch_constraint_inputs(j->w, j->ctx, touching, k, end);
-        fill_constraint(j->w, j->ctx, &ls, &j->cc[k], touching[k]);
+        contact_constraint *c = &j->cc[k];
+        fill_constraint(j->w, j->ctx, &ls, c, touching[k]);
+        t.extras += c->locked || c->rolling > 0.0;
+        t.locked += c->locked != 0;
+        t.shock |= heavy_on_light(bodies, c);
+        mark_in_contact(&in_contact[c->a]);
+        mark_in_contact(&in_contact[c->b]);
     }
+    constraint_totals *sum = &j->totals[worker];
+    sum->extras += t.extras;
+    sum->locked += t.locked;
+    sum->shock |= t.shock;
 }
 
 /* The solver block's bytes (build_constraints): ncon constraints (their
@@ -545,11 +586,13 @@ static int by_order_key(const void *pa, const void *pb)
  * one answer): a merge leaves in place the left run's head below the right
  * run's first key and the right run's tail above the left run's last, found
  * by bisection, and merges only what lies between (hinted keys: a few out
- * of place in long runs). */
-static void sort_order_keys(order_key *a, order_key *tmp, int n, int trim)
+ * of place in long runs). from_width: SORT_RUN for the whole sort; a block
+ * width when each block of that many keys is sorted already. */
+enum { SORT_RUN = 16 };
+static void sort_order_keys(order_key *a, order_key *tmp, int n, int trim, int from_width)
 {
-    enum { RUN = 16 };
-    for (int lo = 0; lo < n; lo += RUN) {
+    enum { RUN = SORT_RUN };
+    for (int lo = 0; from_width == RUN && lo < n; lo += RUN) {
         int hi = lo + RUN < n ? lo + RUN : n;
         for (int i = lo + 1; i < hi; i++) {
             if (by_order_key(&a[i - 1], &a[i]) <= 0) continue;
@@ -559,7 +602,7 @@ static void sort_order_keys(order_key *a, order_key *tmp, int n, int trim)
             a[j] = x;
         }
     }
-    for (int width = RUN; width < n; width *= 2) {
+    for (int width = from_width; width < n; width *= 2) {
         for (int lo = 0; lo + width < n; lo += 2 * width) {
             int mid = lo + width, hi = lo + 2 * width < n ? lo + 2 * width : n;
             if (by_order_key(&a[mid - 1], &a[mid]) <= 0) continue; /* already in order */
@@ -583,6 +626,43 @@ static void sort_order_keys(order_key *a, order_key *tmp, int n, int trim)
             memcpy(a + first, tmp + first, sizeof *a * (size_t)(last - first));
         }
     }
+}
+
+/* The sort in ranges: blocks of SORT_RUN 2^k keys, sorted each by itself
+ * (the same runs and merges the whole sort makes below that width, each
+ * inside one block), then the merges from the block width up on the
+ * calling thread. The keys end in the same order, bit for bit, on any
+ * number of workers. */
+typedef struct sort_job {
+    order_key *a, *tmp;
+    int n, block, trim;
+} sort_job;
+
+static void sort_blocks_range(int begin, int end, int worker, void *p)
+{
+    const sort_job *j = p;
+    (void)worker;
+    for (int b = begin; b < end; b++) {
+        int lo = b * j->block, count = j->n - lo < j->block ? j->n - lo : j->block;
+        sort_order_keys(j->a + lo, j->tmp + lo, count, j->trim, SORT_RUN);
+    }
+}
+
+/* Blocks per worker: enough that a worker finishing early takes another. */
+#define SORT_BLOCKS_PER_WORKER 4
+
+static void sort_order_keys_tasks(const carom_world_def *tasks, order_key *a, order_key *tmp, int n, int trim)
+{
+    int workers = tasks_workers(tasks), block = SORT_RUN;
+    if (workers > 1)
+        while (block < n && (n + block - 1) / block > SORT_BLOCKS_PER_WORKER * workers) block *= 2;
+    if (workers <= 1 || block >= n) {
+        sort_order_keys(a, tmp, n, trim, SORT_RUN);
+        return;
+    }
+    sort_job job = {a, tmp, n, block, trim};
+    tasks_run(tasks, (n + block - 1) / block, 1, sort_blocks_range, &job);
+    sort_order_keys(a, tmp, n, trim, block);
 }
 
 /* Keys in the order of last step's solve order (the hint), the manifolds
@@ -700,7 +780,7 @@ static int sort_touching(carom_world *w, const step_context *ctx)
             a = keys + 2 * n;
             order_by_hint(sm, keys, a, n);
         }
-        sort_order_keys(a, keys + n, n, !nan);
+        sort_order_keys_tasks(ctx->tasks, a, keys + n, n, !nan);
         for (int k = 0; k < n; k++) {
             s->touching[k] = a[k].contact;
             sm->points[k] = a[k].points;
@@ -726,18 +806,12 @@ static void mark_spinless(const carom_world *w, const step_context *ctx, contact
     }
 }
 
-/* The few manifolds with a plane-locked body or rolling resistance get
- * their extra fields (constraint_extra), in constraint order. */
-static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon, int *locked)
+/* The few manifolds with a plane-locked body or rolling resistance (n of
+ * them) get their extra fields (constraint_extra), in constraint order. */
+static int attach_extras(carom_world *w, const step_context *ctx, contact_constraint *cc, int ncon, int n)
 {
     solver_memory *sm = &w->scratch.solver;
     const body_store *bs = &w->bodies;
-    int n = 0, nlocked = 0;
-    for (int k = 0; k < ncon; k++) {
-        n += cc[k].locked || cc[k].rolling > 0.0;
-        nlocked += cc[k].locked != 0;
-    }
-    *locked = nlocked;
     if (n == 0) return 1;
     if (!array_reserve(&sm->extra, &sm->extra_capacity, n, sizeof(constraint_extra))) return 0;
     constraint_extra *x = sm->extra;
@@ -766,12 +840,24 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
     work->level = work->shock_order + ncon;
     work->level_count = work->level + nb + 1;
     work->in_contact = work->level_count + nb + 3;
-    constraint_job job = {w, ctx, cc, NULL};
-    tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
-    if (s->solver.rotation_locked) mark_spinless(w, ctx, cc, ncon);
-    if (!attach_extras(w, ctx, cc, ncon, &work->locked)) return 0;
     for (int b = 0; b < nb; b++) work->in_contact[b] = 0;
-    for (int k = 0; k < ncon; k++) work->in_contact[cc[k].a] = work->in_contact[cc[k].b] = 1;
+    constraint_job job;
+    job.w = w;
+    job.ctx = ctx;
+    job.cc = cc;
+    job.in_contact = work->in_contact;
+    int workers = tasks_workers(ctx->tasks);
+    for (int k = 0; k < workers; k++) job.totals[k].extras = job.totals[k].locked = job.totals[k].shock = 0;
+    tasks_run(ctx->tasks, ncon, CONSTRAINT_MIN_RANGE, fill_constraints_range, &job);
+    int extras = 0;
+    work->locked = work->heavy_on_light = 0;
+    for (int k = 0; k < workers; k++) {
+        extras += job.totals[k].extras;
+        work->locked += job.totals[k].locked;
+        work->heavy_on_light |= job.totals[k].shock;
+    }
+    if (s->solver.rotation_locked) mark_spinless(w, ctx, cc, ncon);
+    if (!attach_extras(w, ctx, cc, ncon, extras)) return 0;
     ctx->constraints = cc;
     ctx->blocks = (contact_block *)((char *)s->solver.block + block_at);
     ctx->constraint_count = ncon;
@@ -781,19 +867,11 @@ static int build_constraints(carom_world *w, step_context *ctx, solver_work *wor
 
 static void plan_shock(const step_context *ctx, solver_work *work)
 {
-    const contact_constraint *cc = ctx->constraints;
-    const impulse_body *bodies = ctx->bodies;
-    int ncon = ctx->constraint_count, shock = 0;
     work->shock_count = 0;
-    if (!ctx->shock_propagation || ctx->penalty) return;
-    /* cheap test first: scenes without a heavy-on-light contact pay nothing */
-    for (int c = 0; c < ncon && !shock; c++) {
-        double ia = bodies[cc[c].a].inv_mass, ib = bodies[cc[c].b].inv_mass;
-        shock = (ia > 0 && ib >= SHOCK_MASS_RATIO * ia) || (ib > 0 && ia >= SHOCK_MASS_RATIO * ib);
-    }
-    if (shock)
-        work->shock_count = compute_levels(ctx->constraints, ncon, bodies, work->level, ctx->body_count,
-                                           work->shock_order, work->level_count);
+    /* scenes without a heavy-on-light contact (build_constraints looked) pay nothing */
+    if (!ctx->shock_propagation || ctx->penalty || !work->heavy_on_light) return;
+    work->shock_count = compute_levels(ctx->constraints, ctx->constraint_count, ctx->bodies, work->level,
+                                       ctx->body_count, work->shock_order, work->level_count);
 }
 
 /* The wide passes (penalty springs keep the scalar loop; the shock pass runs
@@ -1198,7 +1276,9 @@ static void finish_bodies_range(int begin, int end, int worker, void *p)
     finish_job *job = p;
     carom_world *w = job->w;
     const step_context *ctx = job->ctx;
-    int *clamped = &job->clamped[worker], *non_finite = &job->non_finite[worker];
+    /* counted here, added to the worker's as the range ends (the workers'
+     * counts share a cache line) */
+    int clamped_here = 0, non_finite_here = 0, *clamped = &clamped_here, *non_finite = &non_finite_here;
     body_store *bs = &w->bodies;
     double vmax = w->def.max_linear_speed, wmax = world_spin_clamp(&w->def, ctx->h);
     const body_step *motion = w->scratch.solver.motion;
@@ -1251,6 +1331,8 @@ static void finish_bodies_range(int begin, int end, int worker, void *p)
         }
         *clamped += angular_clamped > 0;
     }
+    job->clamped[worker] += clamped_here;
+    job->non_finite[worker] += non_finite_here;
 }
 
 static void finish_bodies(carom_world *w, const step_context *ctx, solver_work *work)
