@@ -29,7 +29,11 @@ void step_context_init(step_context *ctx, const carom_world_def *def, double dt)
     ctx->contact_hertz = dmin(def->contact_hertz, 0.25 / ctx->h);
     ctx->contact_damping_ratio = def->contact_damping_ratio;
     ctx->soft = make_softness(ctx->contact_hertz, def->contact_damping_ratio, ctx->h);
-    ctx->static_soft = make_softness(2.0 * ctx->contact_hertz, def->contact_damping_ratio, ctx->h);
+    /* against a fixed body twice as stiff; without relax passes (fast) never
+     * past the same quarter either */
+    double static_hertz = 2.0 * ctx->contact_hertz;
+    if (def->relax_iterations == 0) static_hertz = dmin(static_hertz, 0.25 / ctx->h);
+    ctx->static_soft = make_softness(static_hertz, def->contact_damping_ratio, ctx->h);
     ctx->correction = def->position_correction;
     ctx->push_max = def->contact_push_max_velocity;
     ctx->slop = def->linear_slop;
