@@ -156,15 +156,31 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
     void *grown = realloc(sc->pose, sizeof *sc->pose * (size_t)(cap > 0 ? cap : 1));
     if (!grown) return 0;
     sc->pose = grown;
+    grown = realloc(sc->ahead, sizeof *sc->ahead * (size_t)(cap > 0 ? cap : 1));
+    if (!grown) return 0;
+    sc->ahead = grown;
     for (int i = 0; i < s->count; i++) {
-        if (s->type[i] == CAROM_BODY_STATIC || !(s->flags[i] & BODY_AWAKE)) continue;
+        look_ahead *la = &sc->ahead[i];
+        if (s->type[i] == CAROM_BODY_STATIC || !(s->flags[i] & BODY_AWAKE)) {
+            la->velocity = v3_zero();
+            la->turn = 0.0;
+            continue;
+        }
         /* the frame and tight bounds once per body, for every pair it is in */
         sc->pose[i] = s->collided[i] = body_xform(s, i);
         sc->tight_box[i] = shape_aabb(&s->shapes[i], sc->pose[i]);
-        aabb box = aabb_fatten(sc->tight_box[i], w->def.speculative_distance);
+        /* a falling body ends the step faster than it began (at dt 1/15 by
+         * 4.4 cm a step), and a spinning one sweeps its corners by its turn:
+         * a capsule at 25 rad/s turns its end 15 cm a step at 60 Hz, where a
+         * look-ahead of its fall alone saw 8.5 cm, and it ended 4.8 cm deep */
+        la->velocity = s->velocity[i];
+        if (s->type[i] == CAROM_BODY_DYNAMIC) la->velocity = v3_madd(la->velocity, dt * s->gravity_scale[i], ctx->gravity);
+        la->turn = v3_len(s->angular_velocity[i]) * dt * (shape_bounding_radius(&s->shapes[i]) + v3_len(s->local_center[i]));
+        if (!(la->turn < INFINITY)) la->turn = 0.0; /* NaN: the step's guard resets the body */
+        aabb box = aabb_fatten(sc->tight_box[i], w->def.speculative_distance + la->turn);
         /* bullets and fast bodies: the box covers this step's travel so their
          * speculative contacts exist before they arrive */
-        vec3 travel = v3_scale(s->velocity[i], dt);
+        vec3 travel = v3_scale(la->velocity, dt);
         if (v3_len2(travel) > 0.25 * WORLD_AABB_MARGIN * WORLD_AABB_MARGIN) {
             box.lo = v3_min(box.lo, v3_add(box.lo, travel));
             box.hi = v3_max(box.hi, v3_add(box.hi, travel));
@@ -425,17 +441,40 @@ static int body_awake(const body_store *s, int slot)
  * calls were ~10 % of the collision stage's instructions. */
 #define COLLIDE_INLINE static inline __attribute__((always_inline))
 
+COLLIDE_INLINE double look_ahead_of(const carom_world *w, const step_context *ctx, const look_ahead *la,
+                                     const look_ahead *lb, int with_turn)
+{
+    double speculative = w->def.speculative_distance;
+    double spec = speculative;
+    vec3 dv = v3_sub(la->velocity, lb->velocity);
+    double l2 = v3_len2(dv) * (ctx->dt * ctx->dt);
+    double turn = with_turn ? la->turn + lb->turn : 0.0;
+    /* (the travel plus the turn stays under 0.9 of it) */
+    if (turn <= 0.1 * spec && l2 < 0.64 * (spec * spec)) return spec;
+    double closing = v3_len(dv) * ctx->dt + turn;
+    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
+    return spec;
+}
+
+/* The turns count against a static or kinematic body only. Its surface
+ * near a contact is a face whose plane the turning body's anchored point
+ * really crosses; between two dynamic bodies both anchors turn about the
+ * step's fixed normal, and that linear guess closes gaps that never close
+ * (seventy boxes spinning at 10 rad/s, 17 cm apart corner to corner, met
+ * speculative contacts that braked them 1.65x faster than Coulomb's law).
+ * There the sweep of toi.c stays the answer to fast turns. */
 COLLIDE_INLINE double pair_look_ahead(const carom_world *w, const step_context *ctx, int a, int b)
 {
     const body_store *s = &w->bodies;
-    double speculative = w->def.speculative_distance;
-    double spec = speculative;
-    vec3 dv = v3_sub(s->velocity[a], s->velocity[b]);
-    double l2 = v3_len2(dv) * (ctx->dt * ctx->dt);
-    if (l2 < 0.81 * (spec * spec)) return spec;
-    double closing = v3_len(dv) * ctx->dt;
-    if (closing > spec) spec = dmin(closing, speculative + 4.0 * WORLD_AABB_MARGIN);
-    return spec;
+    int with_turn = s->type[a] != CAROM_BODY_DYNAMIC || s->type[b] != CAROM_BODY_DYNAMIC;
+    return look_ahead_of(w, ctx, &w->scratch.ahead[a], &w->scratch.ahead[b], with_turn);
+}
+
+/* (collision.h) */
+double world_look_ahead_at_rest(const carom_world *w, const step_context *ctx, int slot)
+{
+    const look_ahead rest = {{0.0, 0.0, 0.0}, 0.0};
+    return look_ahead_of(w, ctx, &w->scratch.ahead[slot], &rest, 1);
 }
 
 /* The narrowphase of a plain (not composite) pair whose fat bounds overlap:

@@ -37,6 +37,8 @@ typedef struct step_scratch {
     int island_capacity;
     aabb *tight_box;            /* per store slot, awake dynamic/kinematic bodies: this step's bounds */
     xform *pose;                /* per store slot, same bodies: this step's body frame */
+    struct look_ahead *ahead;   /* per store slot, every body: the motion the collision stage looks
+                                   ahead for (collision.c; toi.c sweeps what it did not foresee) */
     int slot_capacity;
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;

@@ -17,6 +17,8 @@
 #include "toi.h"
 #include "mesh.h"
 #include "heightfield.h"
+#include "compound.h"
+#include "mesh_scenes.h"
 
 #include "helpers.h"
 
@@ -508,6 +510,124 @@ static void test_far_separation_against_brute_force(void **state)
     heightfield_free(level[1].field);
 }
 
+
+/* ---- motion the contacts did not look ahead for (issue 18, the terrain's landing) ----
+ * A body spinning onto the ground, or one resting there and struck by a
+ * heavy body landing on its end, moves its corners farther in a step than
+ * its travel alone says. Against a plane, a box floor, 1 m tiles, a flat
+ * mesh and a flat height field, at every preset and dt 1/30..1/240: after
+ * every step no body is deeper in the ground than the speculative distance
+ * (the depth measured afresh by the narrowphase at the step's end poses). */
+
+enum { GROUND_PLANE, GROUND_BOX, GROUND_TILES, GROUND_MESH, GROUND_FIELD, GROUND_KINDS };
+static const char *const ground_names[] = {"plane", "box", "tiles", "mesh", "field"};
+
+/* the ground's bodies (up to 100 tiles); returns how many */
+static int add_landing_ground(carom_world *w, int kind, carom_body_id *out)
+{
+    switch (kind) {
+    case GROUND_PLANE: out[0] = add_static(w, carom_shape_plane(0, 0, 1, 0), vec(0, 0, 0)); return 1;
+    case GROUND_BOX: out[0] = add_static(w, carom_shape_box(20, 20, 0.5), vec(0, 0, -0.5)); return 1;
+    case GROUND_TILES: {
+        int n = 0;
+        for (int i = 0; i < 10; i++)
+            for (int j = 0; j < 10; j++) out[n++] = add_static(w, carom_shape_box(0.5, 0.5, 0.5), vec(i - 4.5, j - 4.5, -0.5));
+        return n;
+    }
+    case GROUND_MESH: {
+        double *v;
+        int *t, nv, nt;
+        scene_grid(20, 0.5, 0.0, 7u, &v, &nv, &t, &nt);
+        out[0] = scene_add_mesh(w, v, nv, t, nt, vec(0, 0, 0), about_x(0));
+        free(v);
+        free(t);
+        return 1;
+    }
+    default: out[0] = scene_add_flat_field(w, 41, 41, 0.25, 0.0, vec(0, 0, 0)); return 1;
+    }
+}
+
+/* deepest overlap of body b with any of the ground's bodies at the current poses */
+static double ground_depth(carom_world *w, const carom_body_id *ground, int n, carom_body_id b)
+{
+    const body_store *s = &w->bodies;
+    int sb = s->ids[b.index1 - 1].slot;
+    double deepest = 0;
+    for (int i = 0; i < n; i++) {
+        int sg = s->ids[ground[i].index1 - 1].slot;
+        collide_cache cache;
+        memset(&cache, 0, sizeof cache);
+        cache.feature = -1;
+        manifold m;
+        collide(&s->shapes[sg], body_xform(s, sg), &s->shapes[sb], body_xform(s, sb), 0.0, &cache, &m);
+        for (int k = 0; k < m.count; k++) deepest = dmax(deepest, -m.points[k].separation);
+    }
+    return deepest;
+}
+
+static carom_shape_def landing_shape(int k)
+{
+    static const double hull_pts[24] = {0.25, 0, 0, -0.2, 0.1, 0, 0, 0.25, 0.05, 0, -0.22, 0.02,
+                                        0.05, 0.05, 0.2, -0.05, 0, -0.2, 0.12, -0.1, 0.1, -0.1, -0.12, -0.1};
+    switch (k) {
+    case 0: return carom_shape_capsule(0.15, 0.2);
+    case 1: return carom_shape_box(0.25, 0.2, 0.15);
+    case 2: return carom_shape_cylinder(0.2, 0.15);
+    default: return carom_shape_hull(hull_pts, 8);
+    }
+}
+
+static void test_spun_and_struck_bodies_stay_out_of_the_ground(void **state)
+{
+    (void)state;
+    const double dts[] = {1.0 / 30, 1.0 / 60, 1.0 / 240};
+    double worst[2] = {0, 0};
+    int deep_cases = 0;
+    for (int p = 0; p < 3; p++)
+        for (int g = 0; g < GROUND_KINDS; g++)
+            for (int k = 0; k < 4; k++)
+                for (int d = 0; d < 3; d++)
+                    for (int struck = 0; struck < 2; struck++) {
+                        double dt = dts[d];
+                        carom_world *w = world_preset(presets[p], 1);
+                        carom_body_id ground[100];
+                        int ng = add_landing_ground(w, g, ground);
+                        carom_body_id b;
+                        if (!struck) {
+                            /* falling at 3 m/s, spinning at 25 rad/s about a level axis */
+                            b = add_moving(w, landing_shape(k), vec(0.3, 0.2, 0.6), about_x(0.3), vec(0.5, 0, -3),
+                                           vec(0, 25, 0));
+                        } else {
+                            /* lying at rest; a 100 kg box lands on its end at 6 m/s */
+                            carom_quat lying = about_x(PI_ / 2);
+                            b = add_moving(w, landing_shape(k), vec(0.3, 0.2, k == 0 ? 0.15 : k == 2 ? 0.2 : 0.25),
+                                           k == 0 ? lying : about_x(0), vec(0, 0, 0), vec(0, 0, 0));
+                            carom_body_def h = carom_body_def_default();
+                            h.shape = carom_shape_box(0.3, 0.3, 0.3);
+                            h.mass = 100.0;
+                            h.position = vec(0.3, 0.2 + 0.25, 1.2);
+                            h.linear_velocity = vec(0, 0, -6);
+                            add_body(w, &h);
+                        }
+                        double deepest = 0;
+                        int steps = (int)(1.0 / dt);
+                        for (int i = 0; i < steps; i++) {
+                            assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+                            deepest = dmax(deepest, ground_depth(w, ground, ng, b));
+                        }
+                        worst[struck] = dmax(worst[struck], deepest);
+                        if (deepest > speculative_distance(w)) {
+                            deep_cases++;
+                            print_error("%s %s shape %d dt 1/%.0f %s: %.4f m deep (speculative %.3f)\n", presets[p],
+                                        ground_names[g], k, 1.0 / dt, struck ? "struck" : "spun", deepest,
+                                        speculative_distance(w));
+                        }
+                        carom_world_destroy(w);
+                    }
+    print_message("deepest in the ground: spun %.4f m, struck %.4f m\n", worst[0], worst[1]);
+    assert_int_equal(deep_cases, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -519,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_kinematic_rotation_is_exact),
         cmocka_unit_test(test_issue17_finding6_struck_resting_body_stays_out),
         cmocka_unit_test(test_far_separation_against_brute_force),
+        cmocka_unit_test(test_spun_and_struck_bodies_stay_out_of_the_ground),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
