@@ -48,7 +48,10 @@ done
 peer() { # engine-name binary size
     [ -n "$2" ] && [ -x "$2" ] || return 0
     tmp=$(mktemp)
-    /usr/bin/time -f 'peak_kb=%M' "$2" "pyramids$3" > "$tmp" 2>&1 || { rm -f "$tmp"; return 0; }
+    # a peer that fails (Jolt's harness runs out of temp memory at 49,995) is said, not dropped
+    /usr/bin/time -f 'peak_kb=%M' "$2" "pyramids$3" > "$tmp" 2>&1 || {
+        echo "scaling: $1 at $3 bodies printed no result: $(grep -v -e '^peak_kb=' -e '^Command exited' "$tmp" | tail -n 1)"
+        rm -f "$tmp"; return 0; }
     awk -v e="$1" -v n="$3" '
         /ms_per_step=/ { for (i = 1; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] } }
         /^peak_kb=/ { split($0, kv, "="); kb = kv[2] }
