@@ -199,6 +199,19 @@ static int world_snapshot(lua_State *L)
     return 1;
 }
 
+/* Pushes a userdata array of every body id of the world and returns how
+ * many it holds: a restored world's bodies, listed through the broadphase
+ * (an all-space box), so that the binding learns the ids a snapshot made. */
+static int push_all_body_ids(lua_State *L, carom_world *world, const carom_body_id **ids_out)
+{
+    int count = carom_world_body_count(world);
+    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(count > 0 ? count : 1), 0);
+    carom_vec3 lo = {-1e300, -1e300, -1e300}, hi = {1e300, 1e300, 1e300};
+    int found = carom_world_query_aabb(world, lo, hi, ids, count);
+    *ids_out = ids;
+    return found < count ? found : count;
+}
+
 /* carom.restore(s): a new world from world:snapshot()'s string; it continues
  * bit for bit as the snapshotted world would have. Raises on a string that
  * is not a whole snapshot of this version. */
@@ -218,12 +231,10 @@ static int l_restore(lua_State *L)
     d.event_context = lw;
     carom_world_set_def(lw->world, &d);
     /* every body becomes the world's (world:bodies lists them) */
-    int count = carom_world_body_count(lw->world);
-    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(count > 0 ? count : 1), 0);
-    carom_vec3 lo = {-1e300, -1e300, -1e300}, hi = {1e300, 1e300, 1e300};
-    int found = carom_world_query_aabb(lw->world, lo, hi, ids, count);
+    const carom_body_id *ids;
+    int found = push_all_body_ids(L, lw->world, &ids);
     lua_getiuservalue(L, 2, WORLD_UV_IDS);
-    for (int i = 0; i < found && i < count; i++) {
+    for (int i = 0; i < found; i++) {
         lua_pushboolean(L, 1);
         lua_rawseti(L, -2, (lua_Integer)carom_body_id_pack(ids[i]));
     }
@@ -249,12 +260,10 @@ static int world_restore(lua_State *L)
     lua_newtable(L); /* 4: the new user data */
     if (carom_world_restore_into(lw->world, data, n) != CAROM_OK)
         return clua_arg_error(L, 2, "restore", "%s", carom_world_last_error_reason(lw->world));
-    int count = carom_world_body_count(lw->world);
-    carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(count > 0 ? count : 1), 0); /* 5 */
-    carom_vec3 lo = {-1e300, -1e300, -1e300}, hi = {1e300, 1e300, 1e300};
-    int found = carom_world_query_aabb(lw->world, lo, hi, ids, count);
+    const carom_body_id *ids;
+    int found = push_all_body_ids(L, lw->world, &ids); /* 5 */
     lua_getiuservalue(L, 1, WORLD_UV_DATA); /* 6: the old user data */
-    for (int i = 0; i < found && i < count; i++) {
+    for (int i = 0; i < found; i++) {
         lua_Integer key = (lua_Integer)carom_body_id_pack(ids[i]);
         lua_pushboolean(L, 1);
         lua_rawseti(L, 3, key);
