@@ -339,22 +339,50 @@ static uint64_t f64_bits(double d)
  * bytes are zero); 9..15 its high 16 - t bytes (its low t - 8 bytes are zero). */
 #define CODED_MAX 8
 
-/* The one tag the writer picks for an XOR (the reader refuses any other). */
-SNAP_INLINE int coded_tag(uint64_t x)
+/* The one tag the writer picks for an XOR (the reader refuses any other):
+ * 0 for 0, else with lead / trail its leading / trailing zero bytes,
+ * trail > lead ? 8 + trail (keep the high 8 - trail bytes) : 8 - lead (keep
+ * the low 8 - lead bytes). Looked up by (lead, trail), both counted with a
+ * bit set at the far end (0 alone gives (7, 7), which no other value does):
+ * no branch, one table load (coded_tag_reference is the definition). */
+static const unsigned char coded_tag_of_key[64] = {
+    8, 9, 10, 11, 12, 13, 14, 15, 7, 7, 10, 11, 12, 13, 14, 15, 6, 6, 6, 11, 12, 13, 14, 15, 5, 5, 5, 5, 12, 13, 14, 15,
+    4, 4, 4, 4, 4, 13, 14, 15, 3, 3, 3, 3, 3, 3, 14, 15, 2, 2, 2, 2, 2, 2, 2, 15, 1, 1, 1, 1, 1, 1, 1, 0};
+
+static int coded_tag_reference(uint64_t x)
 {
     if (x == 0) return 0;
-    int lead, trail;
-#if defined(__GNUC__)
-    lead = __builtin_clzll(x) / 8;
-    trail = __builtin_ctzll(x) / 8;
-#else
-    lead = trail = 0;
+    int lead = 0, trail = 0;
     while (!((x >> (56 - 8 * lead)) & 0xff)) lead++;
     while (!((x >> (8 * trail)) & 0xff)) trail++;
-#endif
     /* (trail > lead implies trail > 0) */
-    return trail > lead ? 8 + trail  /* keep the high 8 - trail bytes */
-                        : 8 - lead;  /* keep the low 8 - lead bytes */
+    return trail > lead ? 8 + trail : 8 - lead;
+}
+
+SNAP_INLINE int coded_tag(uint64_t x)
+{
+#if defined(__GNUC__)
+    unsigned lead = (unsigned)__builtin_clzll(x | 1) >> 3, trail = (unsigned)__builtin_ctzll(x | (uint64_t)1 << 63) >> 3;
+    return coded_tag_of_key[lead * 8 + trail];
+#else
+    return coded_tag_reference(x);
+#endif
+}
+
+/* The table against the definition: every pattern of zero and nonzero
+ * bytes, each nonzero byte 0x01, 0x80 or 0xff (tests/test_snapshot.c). */
+int snapshot_coded_tags_disagree(void)
+{
+    static const unsigned byte[3] = {0x01, 0x80, 0xff};
+    int wrong = 0;
+    for (unsigned pattern = 0; pattern < 256; pattern++)
+        for (unsigned b = 0; b < 3; b++) {
+            uint64_t x = 0;
+            for (int k = 0; k < 8; k++)
+                if (pattern >> k & 1) x |= (uint64_t)byte[(b + (unsigned)k) % 3] << (8 * k);
+            wrong += coded_tag(x) != coded_tag_reference(x);
+        }
+    return wrong;
 }
 
 /* A tag's payload length: 1..8 low bytes, 9..15 the high 16 - tag bytes. */
@@ -403,28 +431,34 @@ static void put_coded_slow(writer *o, const double *v, const double *pred, int n
     o->pos += len;
 }
 
-/* The same, inlined: whole 8-byte stores while the group's bytes and 8 more
- * fit in the buffer (the slow way above does the rest: measuring, the last
- * records, big-endian hosts). */
+/* One value of the inlined path: its payload stored as a whole 8-byte word
+ * at *b (the next value's bytes overwrite what is past its length); its tag. */
+SNAP_INLINE unsigned put_coded_word(unsigned char **b, uint64_t x)
+{
+    int tag = coded_tag(x);
+    uint64_t u = x >> coded_shift[tag];
+    memcpy(*b, &u, 8);
+    *b += coded_len[tag];
+    return (unsigned)tag;
+}
+
+/* The same, inlined for groups of up to 4 (every group the format has),
+ * one straight line per value: whole 8-byte stores while the group's bytes
+ * and 8 more fit in the buffer (the slow way above does the rest:
+ * measuring, the last records, big-endian hosts). */
 SNAP_INLINE void put_coded(writer *o, const double *v, const double *pred, int n)
 {
-    if (!SNAP_HOST_LE || o->pos + (size_t)(n + 1) / 2 + 8 * (size_t)n + 8 > o->cap) {
+    if (!SNAP_HOST_LE || n > 4 || o->pos + (size_t)(n + 1) / 2 + 8 * (size_t)n + 8 > o->cap) {
         put_coded_slow(o, v, pred, n);
         return;
     }
-    uint64_t x[CODED_MAX];
-    int tag[CODED_MAX];
-    for (int i = 0; i < n; i++) {
-        x[i] = f64_bits(v[i]) ^ f64_bits(pred[i]);
-        tag[i] = coded_tag(x[i]);
-    }
-    unsigned char *b = o->buf + o->pos;
-    for (int i = 0; i < n; i += 2) *b++ = (unsigned char)(tag[i] | (i + 1 < n ? tag[i + 1] << 4 : 0));
-    for (int i = 0; i < n; i++) {
-        uint64_t u = x[i] >> coded_shift[tag[i]];
-        memcpy(b, &u, 8);
-        b += coded_len[tag[i]];
-    }
+    unsigned char *t = o->buf + o->pos, *b = t + (n + 1) / 2;
+    unsigned tags = put_coded_word(&b, f64_bits(v[0]) ^ f64_bits(pred[0]));
+    if (n > 1) tags |= put_coded_word(&b, f64_bits(v[1]) ^ f64_bits(pred[1])) << 4;
+    if (n > 2) tags |= put_coded_word(&b, f64_bits(v[2]) ^ f64_bits(pred[2])) << 8;
+    if (n > 3) tags |= put_coded_word(&b, f64_bits(v[3]) ^ f64_bits(pred[3])) << 12;
+    t[0] = (unsigned char)tags;
+    if (n > 2) t[1] = (unsigned char)(tags >> 8);
     o->pos = (size_t)(b - o->buf);
 }
 
@@ -467,28 +501,36 @@ static void get_coded_slow(reader *r, double *out, const double *pred, int n, co
         for (int i = 0; i < n; i++) out[i] = 0;
 }
 
-/* The same, without a bounds check per value while a whole group's largest
- * encoding and 8 bytes more are left (every record but the last few): each
- * value one 8-byte load. Anything it refuses goes to the checked way above,
- * which finds the same error. */
+/* One value of the inlined path: its payload from one 8-byte load at *p
+ * (tag says how many of the bytes are its own, and where they go), the
+ * value's bits into *out; *ok cleared unless the tag is the writer's one
+ * for the XOR (coded_tag) and the value finite. */
+SNAP_INLINE void get_coded_word(const unsigned char **p, unsigned tag, const double *pred, double *out, unsigned *ok)
+{
+    uint64_t x;
+    memcpy(&x, *p, 8);
+    x = (x & coded_mask[tag]) << coded_shift[tag];
+    *p += coded_len[tag];
+    uint64_t bits = x ^ f64_bits(*pred);
+    *ok &= ((unsigned)coded_tag(x) == tag) & (((bits >> 52) & 0x7ff) != 0x7ff);
+    memcpy(out, &bits, 8);
+}
+
+/* The same, inlined for groups of up to 4, without a bounds check per value
+ * while a whole group's largest encoding and 8 bytes more are left (every
+ * record but the last few): each value one 8-byte load. Anything it
+ * refuses goes to the checked way above, which finds the same error. */
 SNAP_INLINE void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
 {
-    size_t tags = (size_t)(n + 1) / 2;
-    if (SNAP_HOST_LE && !r->failed && r->size - r->pos >= 4 + 8 * (size_t)n + 8) {
-        const unsigned char *t = r->buf + r->pos, *p = t + tags;
-        uint32_t tw; /* (n <= 8: the tags fit 4 bytes; those past them are not read as tags) */
-        memcpy(&tw, t, 4);
-        int ok = !((n & 1) && ((tw >> (4 * n)) & 15));
-        for (int i = 0; i < n; i++) {
-            int tag = (int)((tw >> (4 * i)) & 15);
-            uint64_t x;
-            memcpy(&x, p, 8);
-            x = (x & coded_mask[tag]) << coded_shift[tag];
-            p += coded_len[tag];
-            uint64_t bits = x ^ f64_bits(pred[i]);
-            ok &= (coded_tag(x) == tag) & (((bits >> 52) & 0x7ff) != 0x7ff);
-            memcpy(&out[i], &bits, 8);
-        }
+    if (SNAP_HOST_LE && n <= 4 && !r->failed && r->size - r->pos >= 2 + 8 * (size_t)n + 8) {
+        const unsigned char *t = r->buf + r->pos, *p = t + (n + 1) / 2;
+        unsigned tw = t[0] | (n > 2 ? (unsigned)t[1] << 8 : 0u);
+        /* (an odd group's last tag byte has its high half unused: zero) */
+        unsigned ok = !((n & 1) && (tw >> (4 * n)));
+        get_coded_word(&p, tw & 15, &pred[0], &out[0], &ok);
+        if (n > 1) get_coded_word(&p, (tw >> 4) & 15, &pred[1], &out[1], &ok);
+        if (n > 2) get_coded_word(&p, (tw >> 8) & 15, &pred[2], &out[2], &ok);
+        if (n > 3) get_coded_word(&p, (tw >> 12) & 15, &pred[3], &out[3], &ok);
         if (ok) {
             r->pos = (size_t)(p - r->buf);
             return;
@@ -531,6 +573,84 @@ SNAP_INLINE double get_coded1(reader *r, double pred, const char *what)
     get_coded(r, &v, &pred, 1, what);
     return v;
 }
+
+/* ---- records: one bounds check each --------------------------------------------- */
+
+/* The most bytes a body or contact record takes (a contact's: ids, head, 3
+ * varints, 8 groups of 3 or 4 coded doubles, 4 points of a varint and 4
+ * groups; every varint 10 bytes at most, a group of n 1 + n / 2 + 8 n), and
+ * the 8 bytes an inlined payload store writes past its value. */
+#define SNAP_RECORD_MAX 1024
+typedef char snapshot_record_max_holds[6 * 10 + 8 * 35 + MANIFOLD_MAX_POINTS * (10 + 4 * 35) + 8 <= SNAP_RECORD_MAX ? 1 : -1];
+
+/* Where a record's bytes go: straight into the buffer when its largest
+ * size fits there, else into scratch (measuring, the last records), which
+ * record_end copies out as far as the capacity goes. Within a record the
+ * writes are unchecked (cur_varint, cur_coded). */
+SNAP_INLINE unsigned char *record_begin(const writer *o, unsigned char *scratch)
+{
+    return o->buf && o->pos <= o->cap && o->cap - o->pos >= SNAP_RECORD_MAX ? o->buf + o->pos : scratch;
+}
+
+SNAP_INLINE void record_end(writer *o, const unsigned char *start, const unsigned char *end, const unsigned char *scratch)
+{
+    size_t len = (size_t)(end - start);
+    if (start == scratch && o->pos < o->cap) memcpy(o->buf + o->pos, scratch, len < o->cap - o->pos ? len : o->cap - o->pos);
+    o->pos += len;
+}
+
+static unsigned char *cur_varint_slow(unsigned char *wp, uint64_t v)
+{
+    while (v >= 0x80) { *wp++ = (unsigned char)((v & 0x7f) | 0x80); v >>= 7; }
+    *wp++ = (unsigned char)v;
+    return wp;
+}
+
+SNAP_INLINE unsigned char *cur_varint(unsigned char *wp, uint64_t v)
+{
+    if (v < 0x80) {
+        wp[0] = (unsigned char)v;
+        return wp + 1;
+    }
+    if (v < (1u << 14)) {
+        wp[0] = (unsigned char)((v & 0x7f) | 0x80);
+        wp[1] = (unsigned char)(v >> 7);
+        return wp + 2;
+    }
+    return cur_varint_slow(wp, v);
+}
+
+/* A group of coded doubles at wp (room for its largest size and 8 more). */
+SNAP_INLINE unsigned char *cur_coded(unsigned char *wp, const double *v, const double *pred, int n)
+{
+    if (!SNAP_HOST_LE || n > 4) { /* (portable: through a writer over the same bytes) */
+        writer o = {wp, (size_t)(n + 1) / 2 + 8 * (size_t)n, 0, NULL};
+        put_coded_slow(&o, v, pred, n);
+        return wp + o.pos;
+    }
+    unsigned char *b = wp + (n + 1) / 2;
+    unsigned tags = put_coded_word(&b, f64_bits(v[0]) ^ f64_bits(pred[0]));
+    if (n > 1) tags |= put_coded_word(&b, f64_bits(v[1]) ^ f64_bits(pred[1])) << 4;
+    if (n > 2) tags |= put_coded_word(&b, f64_bits(v[2]) ^ f64_bits(pred[2])) << 8;
+    if (n > 3) tags |= put_coded_word(&b, f64_bits(v[3]) ^ f64_bits(pred[3])) << 12;
+    wp[0] = (unsigned char)tags;
+    if (n > 2) wp[1] = (unsigned char)(tags >> 8);
+    return b;
+}
+
+SNAP_INLINE unsigned char *cur_coded_v3(unsigned char *wp, vec3 v, vec3 pred)
+{
+    double a[3] = {v.x, v.y, v.z}, p[3] = {pred.x, pred.y, pred.z};
+    return cur_coded(wp, a, p, 3);
+}
+
+SNAP_INLINE unsigned char *cur_coded_q(unsigned char *wp, quat q, quat pred)
+{
+    double a[4] = {q.w, q.x, q.y, q.z}, p[4] = {pred.w, pred.x, pred.y, pred.z};
+    return cur_coded(wp, a, p, 4);
+}
+
+SNAP_INLINE unsigned char *cur_coded1(unsigned char *wp, double v, double pred) { return cur_coded(wp, &v, &pred, 1); }
 
 static int v3_is_zero(vec3 v) { return f64_bits(v.x) == 0 && f64_bits(v.y) == 0 && f64_bits(v.z) == 0; }
 static int same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
@@ -1201,66 +1321,77 @@ static unsigned body_bits(const body_store *s, int i, xform x, aabb fat, int mov
            (same_bits(&s->collided[i], &(xform){guess.p, guess.q}, sizeof(xform)) ? 0 : REC_COLLIDED);
 }
 
-static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
+/* (counting: snapshot_field_bytes's pass, which keeps bytes per field; the
+ * other pass has none of its arithmetic: write_bodies) */
+SNAP_INLINE void write_bodies_pass(writer *o, const carom_world *w, const class_table *t, const xform *pose, const int counting)
 {
     const body_store *s = &w->bodies;
     size_t at = o->pos;
     put_varint(o, (uint64_t)t->count);
     put_bytes(o, t->bytes, t->size);
     put_varint(o, (uint64_t)s->count);
-    acct(o, SNAP_FIELD_classes, at);
+    if (counting) acct(o, SNAP_FIELD_classes, at);
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
+    unsigned char scratch[SNAP_RECORD_MAX];
     for (int i = 0; i < s->count; i++) {
         xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
         unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]), w->def.sleep_time);
-        at = o->pos;
-        put_varint(o, bits);
-        put_varint(o, (uint64_t)t->of_body[i]);
-        acct(o, SNAP_FIELD_body_header, at);
-        at = o->pos;
-        put_coded_v3(o, s->center[i], last_center);
-        acct(o, SNAP_FIELD_body_center, at);
-        at = o->pos;
-        put_coded_q(o, s->rotation[i], last_rotation);
-        acct(o, SNAP_FIELD_body_orientation, at);
+        unsigned char *const record = record_begin(o, scratch);
+        unsigned char *wp = record, *at = wp;
+        wp = cur_varint(wp, bits);
+        wp = cur_varint(wp, (uint64_t)t->of_body[i]);
+        if (counting) o->acct[SNAP_FIELD_body_header] += (size_t)(wp - at);
+        at = wp;
+        wp = cur_coded_v3(wp, s->center[i], last_center);
+        if (counting) o->acct[SNAP_FIELD_body_center] += (size_t)(wp - at);
+        at = wp;
+        wp = cur_coded_q(wp, s->rotation[i], last_rotation);
+        if (counting) o->acct[SNAP_FIELD_body_orientation] += (size_t)(wp - at);
         last_center = s->center[i];
         last_rotation = s->rotation[i];
-        at = o->pos;
-        if (bits & REC_VELOCITY) put_coded_v3(o, s->velocity[i], v3(0, 0, 0));
-        acct(o, SNAP_FIELD_body_velocity, at);
-        at = o->pos;
-        if (bits & REC_SPIN) put_coded_v3(o, s->angular_velocity[i], v3(0, 0, 0));
-        acct(o, SNAP_FIELD_body_spin, at);
-        at = o->pos;
-        if (bits & REC_FORCE) put_coded_v3(o, s->force[i], v3(0, 0, 0));
-        if (bits & REC_TORQUE) put_coded_v3(o, s->torque[i], v3(0, 0, 0));
-        acct(o, SNAP_FIELD_body_force, at);
-        at = o->pos;
-        if (bits & REC_SLEEP_TIME) { put_coded1(o, s->sleep_time[i], last_sleep); last_sleep = s->sleep_time[i]; }
-        acct(o, SNAP_FIELD_body_sleep, at);
-        at = o->pos;
-        if (s->flags[i] & BODY_LOCK_PLANE) put_coded1(o, s->plane_offset[i], v3_dot(s->plane_normal[i], s->center[i]));
-        acct(o, SNAP_FIELD_body_plane, at);
-        at = o->pos;
+        at = wp;
+        if (bits & REC_VELOCITY) wp = cur_coded_v3(wp, s->velocity[i], v3(0, 0, 0));
+        if (counting) o->acct[SNAP_FIELD_body_velocity] += (size_t)(wp - at);
+        at = wp;
+        if (bits & REC_SPIN) wp = cur_coded_v3(wp, s->angular_velocity[i], v3(0, 0, 0));
+        if (counting) o->acct[SNAP_FIELD_body_spin] += (size_t)(wp - at);
+        at = wp;
+        if (bits & REC_FORCE) wp = cur_coded_v3(wp, s->force[i], v3(0, 0, 0));
+        if (bits & REC_TORQUE) wp = cur_coded_v3(wp, s->torque[i], v3(0, 0, 0));
+        if (counting) o->acct[SNAP_FIELD_body_force] += (size_t)(wp - at);
+        at = wp;
+        if (bits & REC_SLEEP_TIME) { wp = cur_coded1(wp, s->sleep_time[i], last_sleep); last_sleep = s->sleep_time[i]; }
+        if (counting) o->acct[SNAP_FIELD_body_sleep] += (size_t)(wp - at);
+        at = wp;
+        if (s->flags[i] & BODY_LOCK_PLANE) wp = cur_coded1(wp, s->plane_offset[i], v3_dot(s->plane_normal[i], s->center[i]));
+        if (counting) o->acct[SNAP_FIELD_body_plane] += (size_t)(wp - at);
+        at = wp;
         if (bits & REC_PREVIOUS) {
-            put_coded_v3(o, s->previous_origin[i], x.p);
-            put_coded_q(o, s->previous_rotation[i], x.q);
+            wp = cur_coded_v3(wp, s->previous_origin[i], x.p);
+            wp = cur_coded_q(wp, s->previous_rotation[i], x.q);
         }
-        acct(o, SNAP_FIELD_body_previous, at);
-        at = o->pos;
+        if (counting) o->acct[SNAP_FIELD_body_previous] += (size_t)(wp - at);
+        at = wp;
         if (bits & REC_COLLIDED) {
             xform p = collided_guess(s, i, x);
-            put_coded_v3(o, s->collided[i].p, p.p);
-            put_coded_q(o, s->collided[i].q, p.q);
+            wp = cur_coded_v3(wp, s->collided[i].p, p.p);
+            wp = cur_coded_q(wp, s->collided[i].q, p.q);
         }
-        acct(o, SNAP_FIELD_body_collided, at);
-        at = o->pos;
-        if (bits & REC_FAT) { put_coded_v3(o, s->fat_box[i].lo, fat.lo); put_coded_v3(o, s->fat_box[i].hi, fat.hi); }
-        acct(o, SNAP_FIELD_body_fat, at);
+        if (counting) o->acct[SNAP_FIELD_body_collided] += (size_t)(wp - at);
+        at = wp;
+        if (bits & REC_FAT) { wp = cur_coded_v3(wp, s->fat_box[i].lo, fat.lo); wp = cur_coded_v3(wp, s->fat_box[i].hi, fat.hi); }
+        if (counting) o->acct[SNAP_FIELD_body_fat] += (size_t)(wp - at);
+        record_end(o, record, wp, scratch);
     }
+}
+
+static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
+{
+    if (o->acct) write_bodies_pass(o, w, t, pose, 1);
+    else write_bodies_pass(o, w, t, pose, 0);
 }
 
 static const xform identity_pose = {{0, 0, 0}, {1, 0, 0, 0}};
@@ -1427,14 +1558,15 @@ SNAP_INLINE unsigned contact_bits(const contact *c, const contact_data *d, conta
 
 /* A contact's two bodies: zvar A's id less the previous contact's A, then
  * var zigzag(B's id - A's id) - 1 (B is never A). */
-SNAP_INLINE void put_pair(writer *o, const contact *c, int *last_a)
+SNAP_INLINE unsigned char *cur_pair(unsigned char *wp, const contact *c, int *last_a)
 {
-    put_varint(o, zigzag((int64_t)c->id_a - *last_a));
-    put_varint(o, zigzag((int64_t)c->id_b - c->id_a) - 1);
+    wp = cur_varint(wp, zigzag((int64_t)c->id_a - *last_a));
+    wp = cur_varint(wp, zigzag((int64_t)c->id_b - c->id_a) - 1);
     *last_a = c->id_a;
+    return wp;
 }
 
-static void write_contacts(writer *o, const carom_world *w, const class_table *t)
+SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const class_table *t, const int counting)
 {
     const body_store *s = &w->bodies;
     const contact_set *cs = &w->contacts;
@@ -1442,8 +1574,9 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
     if (memo) mix_memo_init(memo, t->of_body);
     size_t count_at = o->pos;
     put_varint(o, (uint64_t)cs->count);
-    acct(o, SNAP_FIELD_contact_header, count_at);
+    if (counting) acct(o, SNAP_FIELD_contact_header, count_at);
     int last_a = 0;
+    unsigned char scratch[SNAP_RECORD_MAX];
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         /* the pair as body A, then B (the cache holds new pairs in rank
@@ -1455,13 +1588,15 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
              * what the general path below writes for it, without its
              * predictions (slot 0 reads the empty record: no points, normal,
              * basis or material; not posed) */
-            size_t at = o->pos;
+            unsigned char *const record = record_begin(o, scratch);
+            unsigned char *wp = record, *at = wp;
             unsigned bits = (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
                             (c->cache.feature != -1 ? CREC_FEATURE : 0);
-            put_pair(o, c, &last_a);
-            put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
-            if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
-            acct(o, SNAP_FIELD_contact_header, at);
+            wp = cur_pair(wp, c, &last_a);
+            wp = cur_varint(wp, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
+            if (bits & CREC_FEATURE) wp = cur_varint(wp, zigzag(c->cache.feature));
+            if (counting) o->acct[SNAP_FIELD_contact_header] += (size_t)(wp - at);
+            record_end(o, record, wp, scratch);
             continue;
         }
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
@@ -1488,48 +1623,49 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
                     f64_bits(guess_separation[k]) == f64_bits(d->m.points[k].separation);
         }
         if (exact) bits |= CREC_EXACT;
-        size_t at = o->pos;
-        put_pair(o, c, &last_a);
-        put_varint(o, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
-        if (bits & CREC_SUB) put_varint(o, c->sub);
-        if (bits & CREC_SUB_LIMIT) put_varint(o, c->sub_limit);
-        if (bits & CREC_FEATURE) put_varint(o, zigzag(c->cache.feature));
-        acct(o, SNAP_FIELD_contact_header, at);
-        at = o->pos;
-        if (d->m.count > 0 || (bits & CREC_NORMAL)) put_coded_v3(o, normal, v3(0, 0, 0));
-        acct(o, SNAP_FIELD_contact_normal, at);
-        at = o->pos;
-        if (bits & CREC_CACHE_NORMAL) put_coded_v3(o, c->cache.normal, cache_guess);
-        acct(o, SNAP_FIELD_contact_cache_normal, at);
-        at = o->pos;
+        unsigned char *const record = record_begin(o, scratch);
+        unsigned char *wp = record, *at = wp;
+        wp = cur_pair(wp, c, &last_a);
+        wp = cur_varint(wp, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
+        if (bits & CREC_SUB) wp = cur_varint(wp, c->sub);
+        if (bits & CREC_SUB_LIMIT) wp = cur_varint(wp, c->sub_limit);
+        if (bits & CREC_FEATURE) wp = cur_varint(wp, zigzag(c->cache.feature));
+        if (counting) o->acct[SNAP_FIELD_contact_header] += (size_t)(wp - at);
+        at = wp;
+        if (d->m.count > 0 || (bits & CREC_NORMAL)) wp = cur_coded_v3(wp, normal, v3(0, 0, 0));
+        if (counting) o->acct[SNAP_FIELD_contact_normal] += (size_t)(wp - at);
+        at = wp;
+        if (bits & CREC_CACHE_NORMAL) wp = cur_coded_v3(wp, c->cache.normal, cache_guess);
+        if (counting) o->acct[SNAP_FIELD_contact_cache_normal] += (size_t)(wp - at);
+        at = wp;
         if (bits & CREC_MATERIAL) {
             double v[3] = {d->friction, d->restitution, d->rolling_resistance};
-            put_coded(o, v, g.material, 3);
+            wp = cur_coded(wp, v, g.material, 3);
         }
-        acct(o, SNAP_FIELD_contact_material, at);
-        at = o->pos;
-        if (bits & CREC_TANGENT) put_coded_v3(o, d->tangent1, guess_basis(&g, c));
-        acct(o, SNAP_FIELD_contact_basis, at);
+        if (counting) o->acct[SNAP_FIELD_contact_material] += (size_t)(wp - at);
+        at = wp;
+        if (bits & CREC_TANGENT) wp = cur_coded_v3(wp, d->tangent1, guess_basis(&g, c));
+        if (counting) o->acct[SNAP_FIELD_contact_basis] += (size_t)(wp - at);
         /* only what the collision stage reads under each flag (collision.c):
          * the pose and gap of a pair known apart, the pose and normal of a
          * manifold it may reuse */
         if (bits & CREC_POSE) {
-            at = o->pos;
-            put_coded_v3(o, c->rel_pose.p, rel.p);
-            acct(o, SNAP_FIELD_contact_rel_position, at);
-            at = o->pos;
-            put_coded_q(o, c->rel_pose.q, rel.q);
-            acct(o, SNAP_FIELD_contact_rel_rotation, at);
+            at = wp;
+            wp = cur_coded_v3(wp, c->rel_pose.p, rel.p);
+            if (counting) o->acct[SNAP_FIELD_contact_rel_position] += (size_t)(wp - at);
+            at = wp;
+            wp = cur_coded_q(wp, c->rel_pose.q, rel.q);
+            if (counting) o->acct[SNAP_FIELD_contact_rel_rotation] += (size_t)(wp - at);
         }
-        at = o->pos;
-        if (c->flags & CONTACT_APART) put_coded1(o, c->gap, 0.0);
-        acct(o, SNAP_FIELD_contact_gap, at);
-        at = o->pos;
-        if (bits & CREC_REACH) put_coded1(o, c->reach_b, reach);
-        acct(o, SNAP_FIELD_contact_reach, at);
-        at = o->pos;
-        if (bits & CREC_NORMAL_A) put_coded_v3(o, d->normal_a, normal_a);
-        acct(o, SNAP_FIELD_contact_normal_a, at);
+        at = wp;
+        if (c->flags & CONTACT_APART) wp = cur_coded1(wp, c->gap, 0.0);
+        if (counting) o->acct[SNAP_FIELD_contact_gap] += (size_t)(wp - at);
+        at = wp;
+        if (bits & CREC_REACH) wp = cur_coded1(wp, c->reach_b, reach);
+        if (counting) o->acct[SNAP_FIELD_contact_reach] += (size_t)(wp - at);
+        at = wp;
+        if (bits & CREC_NORMAL_A) wp = cur_coded_v3(wp, d->normal_a, normal_a);
+        if (counting) o->acct[SNAP_FIELD_contact_normal_a] += (size_t)(wp - at);
         /* each point against the one before it (a manifold's points share
          * their scale, most bits of their impulses, often all but a sign) */
         double last[7] = {0, 0, 0, 0, 0, 0, 0};
@@ -1538,15 +1674,15 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
             const contact_point_state *st = &d->state[k];
             double cur[7] = {st->local_a.x, st->local_a.y, st->local_a.z, st->separation,
                              st->normal_impulse, st->tangent_impulse[0], st->tangent_impulse[1]};
-            at = o->pos;
-            put_varint(o, p->id ^ (k ? d->m.points[k - 1].id : 0)); /* (a manifold's ids share their high bits) */
-            acct(o, SNAP_FIELD_point_id, at);
-            at = o->pos;
-            put_coded(o, cur, last, 3);
-            acct(o, SNAP_FIELD_point_local, at);
-            at = o->pos;
-            put_coded(o, cur + 3, last + 3, 4);
-            if (o->acct) { /* the group's bytes by value: half a tag byte each, and its payload */
+            at = wp;
+            wp = cur_varint(wp, p->id ^ (k ? d->m.points[k - 1].id : 0)); /* (a manifold's ids share their high bits) */
+            if (counting) o->acct[SNAP_FIELD_point_id] += (size_t)(wp - at);
+            at = wp;
+            wp = cur_coded(wp, cur, last, 3);
+            if (counting) o->acct[SNAP_FIELD_point_local] += (size_t)(wp - at);
+            at = wp;
+            wp = cur_coded(wp, cur + 3, last + 3, 4);
+            if (counting && o->acct) { /* the group's bytes by value: half a tag byte each, and its payload */
                 static const int field[4] = {SNAP_FIELD_point_separation, SNAP_FIELD_point_normal_impulse,
                                              SNAP_FIELD_point_tangent_impulse, SNAP_FIELD_point_tangent_impulse};
                 for (int v = 0; v < 4; v++) {
@@ -1555,15 +1691,22 @@ static void write_contacts(writer *o, const carom_world *w, const class_table *t
                 }
             }
             if (!exact) {
-                size_t pw = o->pos;
-                put_coded_v3(o, p->point, guess_point[k]);
-                put_coded1(o, p->separation, guess_separation[k]);
-                acct(o, SNAP_FIELD_point_world, pw);
+                unsigned char *pw = wp;
+                wp = cur_coded_v3(wp, p->point, guess_point[k]);
+                wp = cur_coded1(wp, p->separation, guess_separation[k]);
+                if (counting) o->acct[SNAP_FIELD_point_world] += (size_t)(wp - pw);
             }
             memcpy(last, cur, sizeof cur);
         }
+        record_end(o, record, wp, scratch);
     }
     free(memo);
+}
+
+static void write_contacts(writer *o, const carom_world *w, const class_table *t)
+{
+    if (o->acct) write_contacts_pass(o, w, t, 1);
+    else write_contacts_pass(o, w, t, 0);
 }
 
 static void write_world(writer *o, const carom_world *w, const class_table *t, const xform *pose)

@@ -22,4 +22,8 @@ enum { SNAP_FIELDS(SNAP_FIELD_ENUM) SNAP_FIELD_COUNT };
  * over bodies and contacts); names[f] its name. 0 on out of memory. */
 size_t snapshot_field_bytes(const carom_world *w, size_t bytes[SNAP_FIELD_COUNT], const char *names[SNAP_FIELD_COUNT]);
 
+/* How many values the coded doubles' table-driven tag gets otherwise than
+ * their definition (0: it agrees for every pattern of zero bytes). */
+int snapshot_coded_tags_disagree(void);
+
 #endif
