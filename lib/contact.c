@@ -266,10 +266,11 @@ int contact_set_index(contact_set *cs, int *repeated)
     pair_map m;
     int reuse = cs->map.capacity == capacity && cs->map.hashes && cs->map.values;
     int ok = 1;
-    if (reuse) {
+    if (reuse) { /* (emptied here, just before the inserts read it, even when
+                    contact_set_clear emptied it: by now that was long out of cache) */
         m = cs->map;
         m.count = 0;
-        if (cs->map.count) memset(m.values, 0xff, (size_t)capacity * sizeof *m.values);
+        memset(m.values, 0xff, (size_t)capacity * sizeof *m.values);
     } else {
         ok = map_init(&m, capacity);
     }

@@ -779,11 +779,21 @@ hull *hull_make_box(vec3 he)
 void hull_free(hull *h)
 {
     if (!h) return;
+    if (h->shares > 0) {
+        h->shares--;
+        return;
+    }
     free(h->vertices);
     free(h->faces);
     free(h->face_vertices);
     free(h->edges);
     free(h);
+}
+
+hull *hull_share(hull *h)
+{
+    h->shares++;
+    return h;
 }
 
 hull *hull_clone(const hull *h)

@@ -29,13 +29,20 @@ typedef struct hull {
     vec3 centroid;         /* volume centroid in the body frame */
     double volume;
     mat3 unit_inertia;     /* inertia about the centroid for density 1 */
+    int shares;            /* owners besides the first (hull_share); hull_free frees the hull
+                              only when it has none. A hull is never changed once built, so
+                              bodies may share one (a restored snapshot's bodies share their
+                              class's) */
 } hull;
 
 /* Builds a hull from points (xyz triples). Returns NULL and writes a message to
  * err when the points are degenerate (fewer than 4, coplanar, non-finite). */
 hull *hull_build(const double *points, int count, char *err, int err_size);
 hull *hull_make_box(vec3 half_extents);
+/* Gives up one owner's hold: frees the hull when no other owner shares it. */
 void hull_free(hull *h);
 hull *hull_clone(const hull *h);
+/* h, with one more owner (each owner calls hull_free once). */
+hull *hull_share(hull *h);
 
 #endif

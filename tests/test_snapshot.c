@@ -798,6 +798,84 @@ static void test_field_bytes_add_up(void **state)
  * whatever the count (the map doubles through several sizes), its bodies
  * kept in the order given (body A first), and a repeated pair or sub named
  * by the later of the two. */
+/* The hull bodies of a restored world share their class's hull (each
+ * restore used to clone it per body): one hull, held by every body of the
+ * class (shares = bodies - 1), that outlives the bodies destroyed before the
+ * rest and is freed with the last (ASan: no double free, no leak, no read
+ * after free). The restored world and the original continue bit for bit
+ * with hull bodies destroyed in both, and restore_into's spare gives its
+ * holds back when it is read into again. */
+static int hull_holders(const carom_world *w, const hull **shared)
+{
+    int n = 0;
+    *shared = NULL;
+    for (int i = 0; i < w->bodies.count; i++) {
+        const shape *sh = &w->bodies.shapes[i];
+        if (sh->type != SHAPE_HULL) continue;
+        if (!*shared) *shared = sh->hull;
+        if (sh->hull != *shared) fail_msg("body %d has a hull of its own", i);
+        n++;
+    }
+    return n;
+}
+
+static void test_restored_hulls_shared(void **state)
+{
+    (void)state;
+    carom_world_def wd = carom_world_def_default();
+    carom_world *a = carom_world_create(&wd);
+    assert_non_null(a);
+    carom_body_def g = carom_body_def_default();
+    g.type = CAROM_BODY_STATIC;
+    g.shape = carom_shape_plane(0, 0, 1, 0);
+    carom_body_create(a, &g);
+    static const double tetra[] = {0, 0, 0, 0.3, 0, 0, 0, 0.3, 0, 0, 0, 0.3, 0.2, 0.2, 0.2};
+    carom_body_id hulls[6];
+    for (int k = 0; k < 8; k++) {
+        carom_body_def b = carom_body_def_default();
+        b.shape = k < 6 ? carom_shape_hull(tetra, 5) : carom_shape_box(0.2, 0.2, 0.2);
+        b.position = vec(0.5 * k, 0.1 * (k % 3), 0.2 + 0.4 * (k % 2));
+        carom_body_id id = carom_body_create(a, &b);
+        assert_false(carom_body_id_is_null(id));
+        if (k < 6) hulls[k] = id;
+    }
+    for (int k = 0; k < 30; k++) assert_int_equal(carom_world_step(a, 1.0 / 60), CAROM_OK);
+    snap s0 = take(a);
+    char msg[256];
+    carom_world *b = carom_world_restore(s0.data, s0.size, msg, sizeof msg);
+    if (!b) fail_msg("restore: %s", msg);
+    const hull *shared;
+    assert_int_equal(hull_holders(b, &shared), 6);
+    assert_int_equal(shared->shares, 5);
+    /* restored into, twice (the second reads into the first's spare) */
+    carom_world *c = carom_world_restore(s0.data, s0.size, msg, sizeof msg);
+    if (!c) fail_msg("restore: %s", msg);
+    for (int k = 0; k < 2; k++) assert_int_equal(carom_world_restore_into(c, s0.data, s0.size), CAROM_OK);
+    assert_int_equal(hull_holders(c, &shared), 6);
+    assert_int_equal(shared->shares, 5);
+    /* hull bodies destroyed, the first and the last created */
+    carom_world *worlds[3] = {a, b, c};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(carom_body_destroy(worlds[k], hulls[0]), CAROM_OK);
+        assert_int_equal(carom_body_destroy(worlds[k], hulls[5]), CAROM_OK);
+    }
+    assert_int_equal(hull_holders(b, &shared), 4);
+    assert_int_equal(shared->shares, 3);
+    for (int step = 0; step < 120; step++) {
+        for (int k = 0; k < 3; k++) assert_int_equal(carom_world_step(worlds[k], 1.0 / 60), CAROM_OK);
+        snap sa = take(a), sb = take(b), sc = take(c);
+        assert_same_snap(sa, sb, step);
+        assert_same_snap(sa, sc, step);
+        free(sa.data);
+        free(sb.data);
+        free(sc.data);
+    }
+    for (int k = 1; k < 5; k++) assert_int_equal(carom_body_destroy(b, hulls[k]), CAROM_OK);
+    assert_int_equal(hull_holders(b, &shared), 0);
+    for (int k = 0; k < 3; k++) carom_world_destroy(worlds[k]);
+    free(s0.data);
+}
+
 static void test_restored_pair_map(void **state)
 {
     (void)state;
@@ -1032,6 +1110,7 @@ int main(void)
         cmocka_unit_test(test_contact_materials_predicted),
         cmocka_unit_test(test_field_bytes_add_up),
         cmocka_unit_test(test_restored_pair_map),
+        cmocka_unit_test(test_restored_hulls_shared),
         cmocka_unit_test(test_sleeping_pairs_settled),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
