@@ -15,9 +15,12 @@ enum {
     CONTACT_APART        = 1u << 4,   /* no manifold: rel_pose, gap and reach_b are valid */
     CONTACT_ANY_TOUCHING = 1u << 5,   /* sub 0 of a mesh pair: some manifold of the pair has points */
     /* within the collision stage only (collision.c): the manifold was
-     * computed ahead, in parallel, and whether it has points */
+     * computed ahead, in parallel, whether it has points, and whether
+     * exactly one of its bodies is dynamic (the ordered pass then reads no
+     * body) */
     CONTACT_PRECOMPUTED  = 1u << 6,
-    CONTACT_PRECOMPUTED_TOUCHING = 1u << 7
+    CONTACT_PRECOMPUTED_TOUCHING = 1u << 7,
+    CONTACT_PRECOMPUTED_MIXED = 1u << 8
 };
 
 /* A point's state. Its first five fields are also the solver's point

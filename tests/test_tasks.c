@@ -23,8 +23,10 @@
 /* A mixed scene: a grid of piles of boxes, spheres, capsules, cylinders and
  * hulls of several sizes and masses dropped onto the ground and onto each
  * other, a row of plane-locked and rotation-locked bodies, bouncy balls, a
- * kinematic sweeper and a fast bullet that hits the piles. Far from the
- * origin, so that the positions have few bits to spare. */
+ * kinematic sweeper, a fast bullet that hits the piles and boxes sliding
+ * over the seams of a tiled floor (the ghost-contact pass merges their
+ * contacts on two tiles). Far from the origin, so that the positions have
+ * few bits to spare. */
 static void build_scene(carom_world *w)
 {
     static const double tetra[] = {0, 0, 0.3, 0.3, 0, -0.1, -0.15, 0.26, -0.1, -0.15, -0.26, -0.1};
@@ -69,6 +71,20 @@ static void build_scene(carom_world *w)
         d.shape = k % 2 ? carom_shape_box(0.2, 0.2, 0.2) : carom_shape_sphere(0.2);
         d.lock_to_plane = 1;
         d.linear_velocity = vec(0.5 - 0.1 * k, 0.0, 0.0);
+        assert_false(carom_body_id_is_null(carom_body_create(w, &d)));
+    }
+    for (int k = 0; k < 6; k++) { /* the tiles: 1 m boxes side by side, their tops 0.2 m above the ground */
+        carom_body_def t = carom_body_def_default();
+        t.type = CAROM_BODY_STATIC;
+        t.position = vec(ox + 1.0 * k, oy - 6.0, -0.3);
+        t.shape = carom_shape_box(0.5, 0.5, 0.5);
+        assert_false(carom_body_id_is_null(carom_body_create(w, &t)));
+    }
+    for (int k = 0; k < 3; k++) { /* sliding across the seams */
+        carom_body_def d = carom_body_def_default();
+        d.position = vec(ox + 0.3 + 0.6 * k, oy - 6.0 + 0.25 * (k - 1), 0.35);
+        d.shape = carom_shape_box(0.15 + 0.05 * k, 0.15, 0.15);
+        d.linear_velocity = vec(2.0 - 0.4 * k, 0.0, 0.0);
         assert_false(carom_body_id_is_null(carom_body_create(w, &d)));
     }
     carom_body_def kin = carom_body_def_default();
