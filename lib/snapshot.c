@@ -359,7 +359,7 @@ static int coded_tag_reference(uint64_t x)
     return trail > lead ? 8 + trail : 8 - lead;
 }
 
-SNAP_INLINE int coded_tag(uint64_t x)
+SNAP_INLINE int coded_tag_by_key(uint64_t x)
 {
 #if defined(__GNUC__)
     unsigned lead = (unsigned)__builtin_clzll(x | 1) >> 3, trail = (unsigned)__builtin_ctzll(x | (uint64_t)1 << 63) >> 3;
@@ -369,18 +369,64 @@ SNAP_INLINE int coded_tag(uint64_t x)
 #endif
 }
 
-/* The table against the definition: every pattern of zero and nonzero
- * bytes, each nonzero byte 0x01, 0x80 or 0xff (tests/test_snapshot.c). */
+/* The tag by which of the XOR's bytes are nonzero (bit k: byte k): where
+ * SSE2 finds the zero bytes of two values at once (one compare, one mask). */
+static const unsigned char coded_tag_of_bytes[256] = {
+    0, 1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 12, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5,
+    13, 6, 6, 6, 6, 6, 6, 6, 11, 6, 6, 6, 6, 6, 6, 6, 12, 6, 6, 6, 6, 6, 6, 6, 11, 6, 6, 6, 6, 6, 6, 6,
+    14, 7, 7, 7, 10, 7, 7, 7, 11, 7, 7, 7, 10, 7, 7, 7, 12, 7, 7, 7, 10, 7, 7, 7, 11, 7, 7, 7, 10, 7, 7, 7,
+    13, 7, 7, 7, 10, 7, 7, 7, 11, 7, 7, 7, 10, 7, 7, 7, 12, 7, 7, 7, 10, 7, 7, 7, 11, 7, 7, 7, 10, 7, 7, 7,
+    15, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8, 12, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8,
+    13, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8, 12, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8,
+    14, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8, 12, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8,
+    13, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8, 12, 8, 9, 8, 10, 8, 9, 8, 11, 8, 9, 8, 10, 8, 9, 8};
+
+#if defined(__SSE2__) && SNAP_HOST_LE
+#include <emmintrin.h>
+#define SNAP_SSE2 1
+#else
+#define SNAP_SSE2 0
+#endif
+
+/* The tags of two values (of one, with x1 0). */
+SNAP_INLINE void coded_tag2(uint64_t x0, uint64_t x1, unsigned *t0, unsigned *t1)
+{
+#if SNAP_SSE2
+    __m128i v = _mm_set_epi64x((long long)x1, (long long)x0);
+    unsigned nonzero = ~(unsigned)_mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128()));
+    *t0 = coded_tag_of_bytes[nonzero & 255];
+    *t1 = coded_tag_of_bytes[(nonzero >> 8) & 255];
+#else
+    *t0 = (unsigned)coded_tag_by_key(x0);
+    *t1 = (unsigned)coded_tag_by_key(x1);
+#endif
+}
+
+SNAP_INLINE int coded_tag(uint64_t x)
+{
+    unsigned t0, t1;
+    coded_tag2(x, 0, &t0, &t1);
+    return (int)t0;
+}
+
+/* The tables against the definition: every pattern of zero and nonzero
+ * bytes, each nonzero byte 0x01, 0x80 or 0xff, as one value and as either
+ * of a pair (tests/test_snapshot.c). */
 int snapshot_coded_tags_disagree(void)
 {
     static const unsigned byte[3] = {0x01, 0x80, 0xff};
     int wrong = 0;
     for (unsigned pattern = 0; pattern < 256; pattern++)
         for (unsigned b = 0; b < 3; b++) {
-            uint64_t x = 0;
-            for (int k = 0; k < 8; k++)
+            uint64_t x = 0, y = 0;
+            for (int k = 0; k < 8; k++) {
                 if (pattern >> k & 1) x |= (uint64_t)byte[(b + (unsigned)k) % 3] << (8 * k);
-            wrong += coded_tag(x) != coded_tag_reference(x);
+                if (pattern >> (7 - k) & 1) y |= (uint64_t)byte[(b + 2 * (unsigned)k) % 3] << (8 * k);
+            }
+            int want_x = coded_tag_reference(x), want_y = coded_tag_reference(y);
+            unsigned t0, t1;
+            coded_tag2(x, y, &t0, &t1);
+            wrong += (coded_tag_by_key(x) != want_x) + (coded_tag(x) != want_x) + ((int)t0 != want_x) + ((int)t1 != want_y);
         }
     return wrong;
 }
@@ -433,13 +479,30 @@ static void put_coded_slow(writer *o, const double *v, const double *pred, int n
 
 /* One value of the inlined path: its payload stored as a whole 8-byte word
  * at *b (the next value's bytes overwrite what is past its length); its tag. */
-SNAP_INLINE unsigned put_coded_word(unsigned char **b, uint64_t x)
+SNAP_INLINE void put_coded_word(unsigned char **b, uint64_t x, unsigned tag)
 {
-    int tag = coded_tag(x);
     uint64_t u = x >> coded_shift[tag];
     memcpy(*b, &u, 8);
     *b += coded_len[tag];
-    return (unsigned)tag;
+}
+
+/* A group of up to 4 at b, its tags at t (the tags' bytes, then the
+ * payloads): the end of its payloads. */
+SNAP_INLINE unsigned char *put_coded_group(unsigned char *t, const double *v, const double *pred, int n)
+{
+    uint64_t x0 = f64_bits(v[0]) ^ f64_bits(pred[0]), x1 = n > 1 ? f64_bits(v[1]) ^ f64_bits(pred[1]) : 0;
+    uint64_t x2 = n > 2 ? f64_bits(v[2]) ^ f64_bits(pred[2]) : 0, x3 = n > 3 ? f64_bits(v[3]) ^ f64_bits(pred[3]) : 0;
+    unsigned t0, t1, t2 = 0, t3 = 0;
+    coded_tag2(x0, x1, &t0, &t1);
+    if (n > 2) coded_tag2(x2, x3, &t2, &t3);
+    unsigned char *b = t + (n + 1) / 2;
+    put_coded_word(&b, x0, t0);
+    if (n > 1) put_coded_word(&b, x1, t1);
+    if (n > 2) put_coded_word(&b, x2, t2);
+    if (n > 3) put_coded_word(&b, x3, t3);
+    t[0] = (unsigned char)(t0 | t1 << 4);
+    if (n > 2) t[1] = (unsigned char)(t2 | t3 << 4);
+    return b;
 }
 
 /* The same, inlined for groups of up to 4 (every group the format has),
@@ -452,14 +515,7 @@ SNAP_INLINE void put_coded(writer *o, const double *v, const double *pred, int n
         put_coded_slow(o, v, pred, n);
         return;
     }
-    unsigned char *t = o->buf + o->pos, *b = t + (n + 1) / 2;
-    unsigned tags = put_coded_word(&b, f64_bits(v[0]) ^ f64_bits(pred[0]));
-    if (n > 1) tags |= put_coded_word(&b, f64_bits(v[1]) ^ f64_bits(pred[1])) << 4;
-    if (n > 2) tags |= put_coded_word(&b, f64_bits(v[2]) ^ f64_bits(pred[2])) << 8;
-    if (n > 3) tags |= put_coded_word(&b, f64_bits(v[3]) ^ f64_bits(pred[3])) << 12;
-    t[0] = (unsigned char)tags;
-    if (n > 2) t[1] = (unsigned char)(tags >> 8);
-    o->pos = (size_t)(b - o->buf);
+    o->pos = (size_t)(put_coded_group(o->buf + o->pos, v, pred, n) - o->buf);
 }
 
 /* The reader's side; every value decoded must be finite. */
@@ -505,38 +561,64 @@ static void get_coded_slow(reader *r, double *out, const double *pred, int n, co
  * (tag says how many of the bytes are its own, and where they go), the
  * value's bits into *out; *ok cleared unless the tag is the writer's one
  * for the XOR (coded_tag) and the value finite. */
-SNAP_INLINE void get_coded_word(const unsigned char **p, unsigned tag, const double *pred, double *out, unsigned *ok)
+SNAP_INLINE uint64_t get_coded_word(const unsigned char **p, unsigned tag)
 {
     uint64_t x;
     memcpy(&x, *p, 8);
-    x = (x & coded_mask[tag]) << coded_shift[tag];
     *p += coded_len[tag];
-    uint64_t bits = x ^ f64_bits(*pred);
-    *ok &= ((unsigned)coded_tag(x) == tag) & (((bits >> 52) & 0x7ff) != 0x7ff);
-    memcpy(out, &bits, 8);
+    return (x & coded_mask[tag]) << coded_shift[tag];
 }
 
 /* The same, inlined for groups of up to 4, without a bounds check per value
  * while a whole group's largest encoding and 8 bytes more are left (every
- * record but the last few): each value one 8-byte load. Anything it
- * refuses goes to the checked way above, which finds the same error. */
-SNAP_INLINE void get_coded(reader *r, double *out, const double *pred, int n, const char *what)
+ * record but the last few): each value one 8-byte load, its tag checked to
+ * be the writer's one for it (coded_tag2, two values at a time) and the
+ * value finite. Anything it refuses goes to the checked way above, which
+ * finds the same error. */
+SNAP_INLINE void get_coded(reader *restrict r, double *out, const double *pred, int n, const char *what)
 {
     if (SNAP_HOST_LE && n <= 4 && !r->failed && r->size - r->pos >= 2 + 8 * (size_t)n + 8) {
         const unsigned char *t = r->buf + r->pos, *p = t + (n + 1) / 2;
         unsigned tw = t[0] | (n > 2 ? (unsigned)t[1] << 8 : 0u);
-        /* (an odd group's last tag byte has its high half unused: zero) */
-        unsigned ok = !((n & 1) && (tw >> (4 * n)));
-        get_coded_word(&p, tw & 15, &pred[0], &out[0], &ok);
-        if (n > 1) get_coded_word(&p, (tw >> 4) & 15, &pred[1], &out[1], &ok);
-        if (n > 2) get_coded_word(&p, (tw >> 8) & 15, &pred[2], &out[2], &ok);
-        if (n > 3) get_coded_word(&p, (tw >> 12) & 15, &pred[3], &out[3], &ok);
+        unsigned t0 = tw & 15, t1 = (tw >> 4) & 15, t2 = (tw >> 8) & 15, t3 = (tw >> 12) & 15;
+        uint64_t x0 = get_coded_word(&p, t0), x1 = 0, x2 = 0, x3 = 0;
+        if (n > 1) x1 = get_coded_word(&p, t1);
+        if (n > 2) x2 = get_coded_word(&p, t2);
+        if (n > 3) x3 = get_coded_word(&p, t3);
+        unsigned c0, c1, c2 = 0, c3 = 0;
+        coded_tag2(x0, x1, &c0, &c1);
+        if (n > 2) coded_tag2(x2, x3, &c2, &c3);
+        /* (an odd group's last tag byte has its high half unused: zero, the
+         * tag of the absent value's 0; for n <= 2 t2 and t3 are 0 as well) */
+        unsigned ok = (c0 == t0) & (c1 == t1) & (c2 == t2) & (c3 == t3);
+        uint64_t b0 = x0 ^ f64_bits(pred[0]), b1 = n > 1 ? x1 ^ f64_bits(pred[1]) : 0;
+        uint64_t b2 = n > 2 ? x2 ^ f64_bits(pred[2]) : 0, b3 = n > 3 ? x3 ^ f64_bits(pred[3]) : 0;
+        /* (finite: the exponent not all ones) */
+        const uint64_t e = (uint64_t)0x7ff << 52;
+        ok &= ((b0 & e) != e) & ((b1 & e) != e) & ((b2 & e) != e) & ((b3 & e) != e);
+        memcpy(&out[0], &b0, 8);
+        if (n > 1) memcpy(&out[1], &b1, 8);
+        if (n > 2) memcpy(&out[2], &b2, 8);
+        if (n > 3) memcpy(&out[3], &b3, 8);
         if (ok) {
             r->pos = (size_t)(p - r->buf);
             return;
         }
     }
     get_coded_slow(r, out, pred, n, what);
+}
+
+/* One group of n <= 4 coded doubles read from bytes[0, size) against
+ * predictions 0, by the inlined way where size leaves it room, else the
+ * checked one: the bytes it took, or 0 if refused (tests/test_snapshot.c
+ * holds it against the format's definition). */
+size_t snapshot_coded_group_read(const unsigned char *bytes, size_t size, int n, double out[4])
+{
+    static const double zero[4] = {0, 0, 0, 0};
+    reader r = {bytes, size, 0, NULL, 0, 0, SNAP_VERSION, 0, NULL, 0};
+    if (n < 1 || n > 4) return 0;
+    get_coded(&r, out, zero, n, "group");
+    return r.failed ? 0 : r.pos;
 }
 
 SNAP_INLINE void put_coded_v3(writer *o, vec3 v, vec3 pred)
@@ -584,19 +666,28 @@ SNAP_INLINE double get_coded1(reader *r, double pred, const char *what)
 typedef char snapshot_record_max_holds[6 * 10 + 8 * 35 + MANIFOLD_MAX_POINTS * (10 + 4 * 35) + 8 <= SNAP_RECORD_MAX ? 1 : -1];
 
 /* Where a record's bytes go: straight into the buffer when its largest
- * size fits there, else into scratch (measuring, the last records), which
- * record_end copies out as far as the capacity goes. Within a record the
- * writes are unchecked (cur_varint, cur_coded). */
-SNAP_INLINE unsigned char *record_begin(const writer *o, unsigned char *scratch)
+ * size fits there (it starts below `direct`, record_room), else into
+ * scratch (measuring, the last records), which record_end copies out as far
+ * as the capacity goes. Within a record the writes are unchecked
+ * (cur_varint, cur_coded). The record loops keep the position in a local
+ * (the byte stores cannot reach it, so it stays in a register). */
+static size_t record_room(const writer *o)
 {
-    return o->buf && o->pos <= o->cap && o->cap - o->pos >= SNAP_RECORD_MAX ? o->buf + o->pos : scratch;
+    return o->buf && o->cap >= SNAP_RECORD_MAX ? o->cap - SNAP_RECORD_MAX + 1 : 0;
 }
 
-SNAP_INLINE void record_end(writer *o, const unsigned char *start, const unsigned char *end, const unsigned char *scratch)
+SNAP_INLINE unsigned char *record_begin(unsigned char *buf, size_t pos, size_t direct, unsigned char *scratch)
+{
+    return pos < direct ? buf + pos : scratch;
+}
+
+/* The position after the record [start, end). */
+SNAP_INLINE size_t record_end(unsigned char *buf, size_t pos, size_t cap, const unsigned char *start, const unsigned char *end,
+                              const unsigned char *scratch)
 {
     size_t len = (size_t)(end - start);
-    if (start == scratch && o->pos < o->cap) memcpy(o->buf + o->pos, scratch, len < o->cap - o->pos ? len : o->cap - o->pos);
-    o->pos += len;
+    if (start == scratch && pos < cap) memcpy(buf + pos, scratch, len < cap - pos ? len : cap - pos);
+    return pos + len;
 }
 
 static unsigned char *cur_varint_slow(unsigned char *wp, uint64_t v)
@@ -628,14 +719,7 @@ SNAP_INLINE unsigned char *cur_coded(unsigned char *wp, const double *v, const d
         put_coded_slow(&o, v, pred, n);
         return wp + o.pos;
     }
-    unsigned char *b = wp + (n + 1) / 2;
-    unsigned tags = put_coded_word(&b, f64_bits(v[0]) ^ f64_bits(pred[0]));
-    if (n > 1) tags |= put_coded_word(&b, f64_bits(v[1]) ^ f64_bits(pred[1])) << 4;
-    if (n > 2) tags |= put_coded_word(&b, f64_bits(v[2]) ^ f64_bits(pred[2])) << 8;
-    if (n > 3) tags |= put_coded_word(&b, f64_bits(v[3]) ^ f64_bits(pred[3])) << 12;
-    wp[0] = (unsigned char)tags;
-    if (n > 2) wp[1] = (unsigned char)(tags >> 8);
-    return b;
+    return put_coded_group(wp, v, pred, n);
 }
 
 SNAP_INLINE unsigned char *cur_coded_v3(unsigned char *wp, vec3 v, vec3 pred)
@@ -1177,7 +1261,9 @@ static int same_shape(const shape *a, const shape *b)
 }
 static int same_class(const body_store *s, int i, int j)
 {
-    return s->type[i] == s->type[j] && ((s->flags[i] ^ s->flags[j]) & ~(uint32_t)BODY_STATE_FLAGS) == 0 &&
+    /* (the cheap fields that tell classes apart first: the shape's type, the mass) */
+    return s->type[i] == s->type[j] && s->shapes[i].type == s->shapes[j].type && f64_bits(s->mass[i]) == f64_bits(s->mass[j]) &&
+           ((s->flags[i] ^ s->flags[j]) & ~(uint32_t)BODY_STATE_FLAGS) == 0 &&
            same_bits_v3(s->local_center[i], s->local_center[j]) && f64_bits(s->mass[i]) == f64_bits(s->mass[j]) &&
            same_bits(&s->inertia_local[i], &s->inertia_local[j], sizeof(mat3)) &&
            f64_bits(s->friction[i]) == f64_bits(s->friction[j]) && f64_bits(s->restitution[i]) == f64_bits(s->restitution[j]) &&
@@ -1334,12 +1420,13 @@ SNAP_INLINE void write_bodies_pass(writer *o, const carom_world *w, const class_
     vec3 last_center = v3(0, 0, 0);
     quat last_rotation = {1, 0, 0, 0};
     double last_sleep = 0;
-    unsigned char scratch[SNAP_RECORD_MAX];
+    unsigned char scratch[SNAP_RECORD_MAX], *buf = o->buf;
+    size_t pos = o->pos, cap = o->cap, direct = record_room(o);
     for (int i = 0; i < s->count; i++) {
         xform x = pose[i];
         aabb fat = predicted_fat_box(w, i);
         unsigned bits = body_bits(s, i, x, fat, bp_is_moved(w->bp, s->proxy[i]), w->def.sleep_time);
-        unsigned char *const record = record_begin(o, scratch);
+        unsigned char *const record = record_begin(buf, pos, direct, scratch);
         unsigned char *wp = record, *at = wp;
         wp = cur_varint(wp, bits);
         wp = cur_varint(wp, (uint64_t)t->of_body[i]);
@@ -1384,8 +1471,9 @@ SNAP_INLINE void write_bodies_pass(writer *o, const carom_world *w, const class_
         at = wp;
         if (bits & REC_FAT) { wp = cur_coded_v3(wp, s->fat_box[i].lo, fat.lo); wp = cur_coded_v3(wp, s->fat_box[i].hi, fat.hi); }
         if (counting) o->acct[SNAP_FIELD_body_fat] += (size_t)(wp - at);
-        record_end(o, record, wp, scratch);
+        pos = record_end(buf, pos, cap, record, wp, scratch);
     }
+    o->pos = pos;
 }
 
 static void write_bodies(writer *o, const carom_world *w, const class_table *t, const xform *pose)
@@ -1576,7 +1664,8 @@ SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const clas
     put_varint(o, (uint64_t)cs->count);
     if (counting) acct(o, SNAP_FIELD_contact_header, count_at);
     int last_a = 0;
-    unsigned char scratch[SNAP_RECORD_MAX];
+    unsigned char scratch[SNAP_RECORD_MAX], *buf = o->buf;
+    size_t pos = o->pos, cap = o->cap, direct = record_room(o);
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
         /* the pair as body A, then B (the cache holds new pairs in rank
@@ -1588,7 +1677,7 @@ SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const clas
              * what the general path below writes for it, without its
              * predictions (slot 0 reads the empty record: no points, normal,
              * basis or material; not posed) */
-            unsigned char *const record = record_begin(o, scratch);
+            unsigned char *const record = record_begin(buf, pos, direct, scratch);
             unsigned char *wp = record, *at = wp;
             unsigned bits = (c->cache.has_normal ? CREC_HAS_NORMAL : 0) | (c->cache.flip ? CREC_FLIP : 0) |
                             (c->cache.feature != -1 ? CREC_FEATURE : 0);
@@ -1596,7 +1685,7 @@ SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const clas
             wp = cur_varint(wp, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
             if (bits & CREC_FEATURE) wp = cur_varint(wp, zigzag(c->cache.feature));
             if (counting) o->acct[SNAP_FIELD_contact_header] += (size_t)(wp - at);
-            record_end(o, record, wp, scratch);
+            pos = record_end(buf, pos, cap, record, wp, scratch);
             continue;
         }
         int a = s->ids[c->id_a].slot, b = s->ids[c->id_b].slot;
@@ -1623,7 +1712,7 @@ SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const clas
                     f64_bits(guess_separation[k]) == f64_bits(d->m.points[k].separation);
         }
         if (exact) bits |= CREC_EXACT;
-        unsigned char *const record = record_begin(o, scratch);
+        unsigned char *const record = record_begin(buf, pos, direct, scratch);
         unsigned char *wp = record, *at = wp;
         wp = cur_pair(wp, c, &last_a);
         wp = cur_varint(wp, (uint64_t)c->flags | (uint64_t)bits << CONTACT_FLAG_BITS);
@@ -1698,8 +1787,9 @@ SNAP_INLINE void write_contacts_pass(writer *o, const carom_world *w, const clas
             }
             memcpy(last, cur, sizeof cur);
         }
-        record_end(o, record, wp, scratch);
+        pos = record_end(buf, pos, cap, record, wp, scratch);
     }
+    o->pos = pos;
     free(memo);
 }
 

@@ -25,5 +25,8 @@ size_t snapshot_field_bytes(const carom_world *w, size_t bytes[SNAP_FIELD_COUNT]
 /* How many values the coded doubles' table-driven tag gets otherwise than
  * their definition (0: it agrees for every pattern of zero bytes). */
 int snapshot_coded_tags_disagree(void);
+/* One group of n <= 4 coded doubles from bytes[0, size), predicted 0: the
+ * bytes it took, 0 if the reader refuses it. */
+size_t snapshot_coded_group_read(const unsigned char *bytes, size_t size, int n, double out[4]);
 
 #endif

@@ -424,6 +424,64 @@ static void test_snapshot_into_any_capacity(void **state)
     carom_world_destroy(w);
 }
 
+/* The reader takes a group of coded doubles only in the writer's one form
+ * (docs/snapshot.md): tag 0 no bytes; 1..8 the low t bytes, the highest of
+ * them nonzero, and not a value whose trailing zero bytes outnumber its
+ * leading ones (that one is sent high); 9..15 the high 16 - t bytes, the
+ * lowest nonzero, and its trailing zero bytes more than its leading ones; an
+ * odd group's unused nibble 0; every value finite. Random tags and
+ * payloads (bytes often zero), n = 1..4, read with room after them (the
+ * inlined way) and cut to their length (the checked way): both agree with
+ * that definition. */
+static int tag_by_definition(uint64_t x)
+{
+    if (x == 0) return 0;
+    int lead = 0, trail = 0;
+    while (!((x >> (56 - 8 * lead)) & 0xff)) lead++;
+    while (!((x >> (8 * trail)) & 0xff)) trail++;
+    return trail > lead ? 8 + trail : 8 - lead;
+}
+
+static void test_coded_groups_one_form(void **state)
+{
+    (void)state;
+    static const int len_of[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 7, 6, 5, 4, 3, 2, 1};
+    unsigned seed = 777;
+    int accepted = 0, refused = 0;
+    for (int trial = 0; trial < 200000; trial++) {
+        int n = 1 + trial % 4;
+        unsigned char bytes[2 + 32 + 64];
+        size_t at = (size_t)(n + 1) / 2;
+        int ok = 1;
+        memset(bytes, 0, sizeof bytes);
+        for (int i = 0; i < n + (n & 1); i++) {
+            seed = seed * 1103515245u + 12345u;
+            int tag = (int)(seed >> 16) & 15;
+            if (i == n) tag = (seed >> 20) % 8 ? 0 : tag; /* the unused nibble: mostly 0 */
+            bytes[i / 2] |= (unsigned char)(tag << (4 * (i & 1)));
+            if (i == n) { ok &= tag == 0; break; }
+            uint64_t x = 0;
+            for (int k = 0; k < len_of[tag]; k++) {
+                seed = seed * 1103515245u + 12345u;
+                unsigned b = (seed >> 16) & 3 ? (seed >> 8) & 0xff : 0; /* a quarter zero bytes, as well as any 0 drawn */
+                bytes[at + (size_t)k] = (unsigned char)b;
+                x |= (uint64_t)b << (8 * (tag <= 8 ? k : k + tag - 8));
+            }
+            at += (size_t)len_of[tag];
+            ok &= tag_by_definition(x) == tag && ((x >> 52) & 0x7ff) != 0x7ff;
+        }
+        double out[4];
+        size_t roomy = snapshot_coded_group_read(bytes, sizeof bytes, n, out);
+        size_t cut = snapshot_coded_group_read(bytes, at, n, out);
+        if ((roomy != 0) != ok || (cut != 0) != ok || (ok && (roomy != at || cut != at)))
+            fail_msg("trial %d (n %d): the definition says %s, the reader took %zu and %zu bytes of %zu", trial, n,
+                     ok ? "take" : "refuse", roomy, cut, at);
+        if (ok) accepted++;
+        else refused++;
+    }
+    print_message("coded groups: %d taken, %d refused, as defined\n", accepted, refused);
+}
+
 static void test_bad_snapshots_refused(void **state)
 {
     (void)state;
@@ -1103,6 +1161,7 @@ int main(void)
         cmocka_unit_test(test_restore_continues_bitwise),
         cmocka_unit_test(test_restore_into),
         cmocka_unit_test(test_snapshot_into_any_capacity),
+        cmocka_unit_test(test_coded_groups_one_form),
         cmocka_unit_test(test_bad_snapshots_refused),
         cmocka_unit_test(test_reads_format_7),
         cmocka_unit_test(test_truncated_body_records_named),
