@@ -304,18 +304,39 @@ static int get_small_slow(reader *r, int64_t lo, int64_t hi, int is_signed, cons
     return (int)v;
 }
 
-/* A varint that must fit an int in [lo, hi]: a one- or two-byte one in
- * range is taken here (inlined at every record's fields); anything else is
- * read, and refused, by the checked way above from the same position. */
+/* A varint that must fit an int in [lo, hi]: one of up to 8 bytes in range
+ * is taken here from one 8-byte load (inlined at every record's fields);
+ * anything else is read, and refused, by the checked way above from the
+ * same position. */
 SNAP_INLINE int get_small(reader *r, int64_t lo, int64_t hi, int is_signed, const char *what)
 {
     if (!r->failed && r->size - r->pos >= 10) {
         const unsigned char *p = r->buf + r->pos;
         uint64_t u;
         size_t len;
-        if (p[0] < 0x80) u = p[0], len = 1;
-        else if (p[1] < 0x80 && p[1] != 0) u = (uint64_t)(p[0] & 0x7f) | (uint64_t)p[1] << 7, len = 2;
-        else return get_small_slow(r, lo, hi, is_signed, what);
+        if (p[0] < 0x80) {
+            u = p[0], len = 1;
+        } else if (p[1] < 0x80 && p[1] != 0) {
+            u = (uint64_t)(p[0] & 0x7f) | (uint64_t)p[1] << 7, len = 2;
+        } else {
+#if defined(__GNUC__)
+            /* up to 8 bytes from one load: the first byte without the
+             * continuation bit ends it (and must not be 0: a needless byte) */
+            uint64_t word = 0;
+            if (SNAP_HOST_LE) memcpy(&word, p, 8);
+            else for (int k = 7; k >= 0; k--) word = (word << 8) | p[k];
+            uint64_t stop = ~word & 0x8080808080808080ULL;
+            unsigned bit = stop ? (unsigned)__builtin_ctzll(stop) : 0; /* (the last byte's bit 7) */
+            if (!stop || !((word >> (bit - 7)) & 0x7f)) return get_small_slow(r, lo, hi, is_signed, what);
+            word &= ((stop & (0 - stop)) << 1) - 1; /* (its bytes: up to the stop bit; all 64 when it is bit 63) */
+            u = (word & 0x7f) | (word >> 1 & 0x7fULL << 7) | (word >> 2 & 0x7fULL << 14) | (word >> 3 & 0x7fULL << 21) |
+                (word >> 4 & 0x7fULL << 28) | (word >> 5 & 0x7fULL << 35) | (word >> 6 & 0x7fULL << 42) |
+                (word >> 7 & 0x7fULL << 49);
+            len = bit / 8 + 1;
+#else
+            return get_small_slow(r, lo, hi, is_signed, what);
+#endif
+        }
         int64_t v = is_signed ? unzigzag(u) : (int64_t)u;
         if (v >= lo && v <= hi) {
             r->pos += len;
@@ -618,6 +639,15 @@ size_t snapshot_coded_group_read(const unsigned char *bytes, size_t size, int n,
     reader r = {bytes, size, 0, NULL, 0, 0, SNAP_VERSION, 0, NULL, 0};
     if (n < 1 || n > 4) return 0;
     get_coded(&r, out, zero, n, "group");
+    return r.failed ? 0 : r.pos;
+}
+
+/* One varint in [lo, hi] from bytes[0, size) as the records read it
+ * (tests/test_snapshot.c): the bytes it took, 0 if refused. */
+size_t snapshot_small_read(const unsigned char *bytes, size_t size, int64_t lo, int64_t hi, int is_signed, int *out)
+{
+    reader r = {bytes, size, 0, NULL, 0, 0, SNAP_VERSION, 0, NULL, 0};
+    *out = get_small(&r, lo, hi, is_signed, "varint");
     return r.failed ? 0 : r.pos;
 }
 

@@ -4,6 +4,7 @@
 #define CAROM_SNAPSHOT_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "world.h"
 
 #define SNAP_FIELDS(X)                                                                                          \
@@ -28,5 +29,8 @@ int snapshot_coded_tags_disagree(void);
 /* One group of n <= 4 coded doubles from bytes[0, size), predicted 0: the
  * bytes it took, 0 if the reader refuses it. */
 size_t snapshot_coded_group_read(const unsigned char *bytes, size_t size, int n, double out[4]);
+/* One varint in [lo, hi] (zigzag when is_signed) from bytes[0, size): the
+ * bytes it took, 0 if the reader refuses it. */
+size_t snapshot_small_read(const unsigned char *bytes, size_t size, int64_t lo, int64_t hi, int is_signed, int *out);
 
 #endif

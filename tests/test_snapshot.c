@@ -482,6 +482,55 @@ static void test_coded_groups_one_form(void **state)
     print_message("coded groups: %d taken, %d refused, as defined\n", accepted, refused);
 }
 
+/* Varints likewise: 1 to 11 random bytes (continuation bits mostly set,
+ * last bytes often 0), read with room (the one-load way) and cut to 9 bytes
+ * or fewer (the checked way), against [lo, hi] ranges of every size, signed
+ * and not: taken exactly when the bytes are one value's only encoding (no
+ * needless last 0 byte, at most 64 bits) in range. */
+static void test_varints_one_form(void **state)
+{
+    (void)state;
+    unsigned seed = 4242;
+    int accepted = 0, refused = 0;
+    for (int trial = 0; trial < 200000; trial++) {
+        unsigned char bytes[32];
+        memset(bytes, 0, sizeof bytes);
+        seed = seed * 1103515245u + 12345u;
+        int n = 1 + (int)((seed >> 16) % 11);
+        for (int k = 0; k < n; k++) {
+            seed = seed * 1103515245u + 12345u;
+            unsigned b = (seed >> 8) & 0x7f;
+            if ((seed >> 20) % 4 == 0) b = 0;
+            bytes[k] = (unsigned char)(b | (k + 1 < n ? 0x80 : 0));
+        }
+        seed = seed * 1103515245u + 12345u;
+        int is_signed = (seed >> 16) & 1;
+        int64_t hi = ((seed >> 17) & 1) ? INT32_MAX : (int64_t)1 << ((seed >> 18) % 31), lo = is_signed ? -hi : 0;
+        /* the definition */
+        uint64_t u = 0;
+        int ok = 1;
+        for (int k = 0; k < n; k++) {
+            if (7 * k >= 64 || (k == 9 && (bytes[k] & 0x7f) > 1)) { ok = 0; break; }
+            u |= (uint64_t)(bytes[k] & 0x7f) << (7 * k);
+        }
+        if (n > 1 && bytes[n - 1] == 0) ok = 0;
+        int64_t v = is_signed ? (int64_t)(u >> 1) ^ -(int64_t)(u & 1) : (int64_t)u;
+        if (ok && (v < lo || v > hi || (!is_signed && u > (uint64_t)INT64_MAX))) ok = 0;
+        int got_roomy = 0, got_cut = 0;
+        size_t roomy = snapshot_small_read(bytes, sizeof bytes, lo, hi, is_signed, &got_roomy);
+        size_t cut = snapshot_small_read(bytes, (size_t)n < 9 ? (size_t)n : 9, lo, hi, is_signed, &got_cut);
+        if (n > 9) cut = roomy; /* (cut short of the value: not a test of it) */
+        else got_cut = got_roomy;
+        if ((roomy != 0) != ok || (cut != 0) != ok || (ok && (roomy != (size_t)n || got_roomy != (int)v)))
+            fail_msg("trial %d (%d bytes, [%lld, %lld]%s): the definition says %s, the reader took %zu and %zu bytes", trial, n,
+                     (long long)lo, (long long)hi, is_signed ? " signed" : "", ok ? "take" : "refuse", roomy, cut);
+        (void)got_cut;
+        if (ok) accepted++;
+        else refused++;
+    }
+    print_message("varints: %d taken, %d refused, as defined\n", accepted, refused);
+}
+
 static void test_bad_snapshots_refused(void **state)
 {
     (void)state;
@@ -1162,6 +1211,7 @@ int main(void)
         cmocka_unit_test(test_restore_into),
         cmocka_unit_test(test_snapshot_into_any_capacity),
         cmocka_unit_test(test_coded_groups_one_form),
+        cmocka_unit_test(test_varints_one_form),
         cmocka_unit_test(test_bad_snapshots_refused),
         cmocka_unit_test(test_reads_format_7),
         cmocka_unit_test(test_truncated_body_records_named),
