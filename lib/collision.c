@@ -145,25 +145,35 @@ static void add_pair(carom_world *w, int ida, int idb)
     material_mix_contact(w, ci);
 }
 
-int world_update_pairs(carom_world *w, const step_context *ctx)
+/* Bodies per range handed to the task hooks. */
+#define BODY_MIN_RANGE 256
+
+typedef struct refit_job {
+    carom_world *w;
+    const step_context *ctx;
+    unsigned char *refit; /* NULL: move each proxy here (one range, in slot order) */
+} refit_job;
+
+/* Each awake body's frame, tight bounds, look-ahead and, where those left
+ * its fat bounds, new fat bounds; refit[i] says which proxies must move.
+ * The moves change the broadphase tree, so on several workers they are made
+ * afterwards, in slot order, on the calling thread: the same tree as one
+ * worker's. */
+static void refit_bodies_range(int begin, int end, int worker, void *p)
 {
+    const refit_job *j = p;
+    carom_world *w = j->w;
     body_store *s = &w->bodies;
     step_scratch *sc = &w->scratch;
-    double dt = ctx->dt;
-    if (!array_reserve_near((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
-    /* the pose array shares the capacity: grow it to match */
-    int cap = sc->slot_capacity;
-    void *grown = realloc(sc->pose, sizeof *sc->pose * (size_t)(cap > 0 ? cap : 1));
-    if (!grown) return 0;
-    sc->pose = grown;
-    grown = realloc(sc->ahead, sizeof *sc->ahead * (size_t)(cap > 0 ? cap : 1));
-    if (!grown) return 0;
-    sc->ahead = grown;
-    for (int i = 0; i < s->count; i++) {
+    double dt = j->ctx->dt;
+    vec3 gravity = j->ctx->gravity;
+    (void)worker;
+    for (int i = begin; i < end; i++) {
         look_ahead *la = &sc->ahead[i];
         if (s->type[i] == CAROM_BODY_STATIC || !(s->flags[i] & BODY_AWAKE)) {
             la->velocity = v3_zero();
             la->turn = 0.0;
+            if (j->refit) j->refit[i] = 0;
             continue;
         }
         /* the frame and tight bounds once per body, for every pair it is in */
@@ -174,7 +184,7 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
          * a capsule at 25 rad/s turns its end 15 cm a step at 60 Hz, where a
          * look-ahead of its fall alone saw 8.5 cm, and it ended 4.8 cm deep */
         la->velocity = s->velocity[i];
-        if (s->type[i] == CAROM_BODY_DYNAMIC) la->velocity = v3_madd(la->velocity, dt * s->gravity_scale[i], ctx->gravity);
+        if (s->type[i] == CAROM_BODY_DYNAMIC) la->velocity = v3_madd(la->velocity, dt * s->gravity_scale[i], gravity);
         la->turn = v3_len(s->angular_velocity[i]) * dt * (shape_bounding_radius(&s->shapes[i]) + v3_len(s->local_center[i]));
         if (!(la->turn < INFINITY)) la->turn = 0.0; /* NaN: the step's guard resets the body */
         aabb box = aabb_fatten(sc->tight_box[i], w->def.speculative_distance + la->turn);
@@ -185,11 +195,39 @@ int world_update_pairs(carom_world *w, const step_context *ctx)
             box.lo = v3_min(box.lo, v3_add(box.lo, travel));
             box.hi = v3_max(box.hi, v3_add(box.hi, travel));
         }
-        if (!aabb_contains(s->fat_box[i], box)) {
-            aabb fat = aabb_fatten(box, WORLD_AABB_MARGIN);
-            s->fat_box[i] = fat;
-            bp_move_proxy(w->bp, s->proxy[i], fat);
-        }
+        int refit = !aabb_contains(s->fat_box[i], box);
+        if (refit) s->fat_box[i] = aabb_fatten(box, WORLD_AABB_MARGIN);
+        if (j->refit) j->refit[i] = (unsigned char)refit;
+        else if (refit) bp_move_proxy(w->bp, s->proxy[i], s->fat_box[i]);
+    }
+}
+
+int world_update_pairs(carom_world *w, const step_context *ctx)
+{
+    body_store *s = &w->bodies;
+    step_scratch *sc = &w->scratch;
+    if (!array_reserve_near((void **)&sc->tight_box, &sc->slot_capacity, s->count, sizeof *sc->tight_box)) return 0;
+    /* the pose array shares the capacity: grow it to match */
+    int cap = sc->slot_capacity;
+    void *grown = realloc(sc->pose, sizeof *sc->pose * (size_t)(cap > 0 ? cap : 1));
+    if (!grown) return 0;
+    sc->pose = grown;
+    grown = realloc(sc->ahead, sizeof *sc->ahead * (size_t)(cap > 0 ? cap : 1));
+    if (!grown) return 0;
+    sc->ahead = grown;
+    int workers = tasks_workers(&w->def);
+    if (workers > 1) {
+        grown = realloc(sc->refit, (size_t)(cap > 0 ? cap : 1));
+        if (!grown) return 0;
+        sc->refit = grown;
+    }
+    refit_job job = {w, ctx, workers > 1 ? sc->refit : NULL};
+    if (workers > 1) {
+        tasks_run(&w->def, s->count, BODY_MIN_RANGE, refit_bodies_range, &job);
+        for (int i = 0; i < s->count; i++)
+            if (sc->refit[i]) bp_move_proxy(w->bp, s->proxy[i], s->fat_box[i]);
+    } else {
+        refit_bodies_range(0, s->count, 0, &job);
     }
     sc->new_pair_count = 0;
     bp_update_pairs(w->bp, collect_pair, w);

@@ -209,7 +209,7 @@ CAROM_API void carom_world_destroy(carom_world *w)
     solver_memory_free(&s->solver);
     impact_memory_free(&s->impact);
     free(s->island_parent); free(s->deferred_destroy); free(s->deferred_ops);
-    free(s->tight_box); free(s->pose); free(s->ahead); free(s->touching); free(s->mixed);
+    free(s->tight_box); free(s->pose); free(s->ahead); free(s->refit); free(s->touching); free(s->mixed);
     free(w->sensor_overlaps);
     free(s->new_pairs); free(s->asleep_pairs); free(s->toi); free(s->toi_bodies); free(s->toi_fast); free(s->toi_near); free(s->merged);
     carom_world_destroy(w->spare);

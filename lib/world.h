@@ -39,6 +39,8 @@ typedef struct step_scratch {
     xform *pose;                /* per store slot, same bodies: this step's body frame */
     struct look_ahead *ahead;   /* per store slot, every body: the motion the collision stage looks
                                    ahead for (collision.c; toi.c sweeps what it did not foresee) */
+    unsigned char *refit;       /* per store slot, on several workers: 1 where the collision stage
+                                   moves the body's proxy (collision.c) */
     int slot_capacity;
     int *touching;              /* contacts solved this step (SIM and TOUCHING), by index */
     int touching_count, touching_capacity;
