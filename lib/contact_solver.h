@@ -19,6 +19,7 @@ typedef struct contact_block {
     int stiff;                   /* springs past a quarter of the sub-step rate: swept again (contact_solve_normals) */
     int column;                  /* in a column solved directly (column_solve.c; set before prepare) */
     int column_done;             /* this pass's normal rows already solved by its column */
+    int friction_first;          /* every point warm-started pressed and sticking: friction rows first (solve_manifold) */
 } contact_block;
 
 /* The soft rows' compliance factor gamma: c_i = gamma K_ii (0: rigid rows). */

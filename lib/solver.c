@@ -953,7 +953,13 @@ static void prepare_points(const step_context *ctx, solver_work *work)
         work->max_penetration = dmax(work->max_penetration, contact_prepare(c, ctx));
         if (!work->wide) work->points += c->count;
         /* the penalty model prepares no blocks (contact_prepare) */
-        if (ctx->blocks && !ctx->penalty) work->stiff += ctx->blocks[c - ctx->constraints].stiff;
+        if (ctx->blocks && !ctx->penalty) {
+            contact_block *blk = &ctx->blocks[c - ctx->constraints];
+            work->stiff += blk->stiff;
+            /* friction rows last where a heavy body rests on a light one
+             * (contact_solver.c, solve_manifold) */
+            if (work->heavy_on_light) blk->friction_first = 0;
+        }
     }
 }
 
