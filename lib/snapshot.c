@@ -526,18 +526,6 @@ SNAP_INLINE unsigned char *put_coded_group(unsigned char *t, const double *v, co
     return b;
 }
 
-/* The same, inlined for groups of up to 4 (every group the format has),
- * one straight line per value: whole 8-byte stores while the group's bytes
- * and 8 more fit in the buffer (the slow way above does the rest:
- * measuring, the last records, big-endian hosts). */
-SNAP_INLINE void put_coded(writer *o, const double *v, const double *pred, int n)
-{
-    if (!SNAP_HOST_LE || n > 4 || o->pos + (size_t)(n + 1) / 2 + 8 * (size_t)n + 8 > o->cap) {
-        put_coded_slow(o, v, pred, n);
-        return;
-    }
-    o->pos = (size_t)(put_coded_group(o->buf + o->pos, v, pred, n) - o->buf);
-}
 
 /* The reader's side; every value decoded must be finite. */
 static void get_coded_slow(reader *r, double *out, const double *pred, int n, const char *what)
@@ -651,23 +639,11 @@ size_t snapshot_small_read(const unsigned char *bytes, size_t size, int64_t lo, 
     return r.failed ? 0 : r.pos;
 }
 
-SNAP_INLINE void put_coded_v3(writer *o, vec3 v, vec3 pred)
-{
-    double a[3] = {v.x, v.y, v.z}, p[3] = {pred.x, pred.y, pred.z};
-    put_coded(o, a, p, 3);
-}
-
 SNAP_INLINE vec3 get_coded_v3(reader *r, vec3 pred, const char *what)
 {
     double a[3], p[3] = {pred.x, pred.y, pred.z};
     get_coded(r, a, p, 3, what);
     return v3(a[0], a[1], a[2]);
-}
-
-SNAP_INLINE void put_coded_q(writer *o, quat q, quat pred)
-{
-    double a[4] = {q.w, q.x, q.y, q.z}, p[4] = {pred.w, pred.x, pred.y, pred.z};
-    put_coded(o, a, p, 4);
 }
 
 SNAP_INLINE quat get_coded_q(reader *r, quat pred, const char *what)
@@ -678,7 +654,6 @@ SNAP_INLINE quat get_coded_q(reader *r, quat pred, const char *what)
     return q;
 }
 
-SNAP_INLINE void put_coded1(writer *o, double v, double pred) { put_coded(o, &v, &pred, 1); }
 SNAP_INLINE double get_coded1(reader *r, double pred, const char *what)
 {
     double v;
