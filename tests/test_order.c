@@ -6,7 +6,10 @@
  * on 1 m box tiles (issue #18: made before its floor it used to stop 1.1 mm
  * farther), a pyramid, a pile of boxes and spheres between walls, and a
  * mixed scene of every convex shape, a compound, a hull and a kinematic
- * paddle on a plane and static boxes. */
+ * paddle on a plane and static boxes; and level geometry (issue #18): a
+ * mix of every shape, thin plates and compounds dropped on a bumpy mesh and
+ * on a height field with holes, also 1e4 m out, and bodies sliding and
+ * rolling across separate mesh patches and box tiles. */
 #include <stdarg.h>
 #include <stdlib.h>
 #include <stddef.h>
@@ -28,8 +31,13 @@ typedef struct scene {
     carom_body_def def[MAX_BODIES];
     int n;
     int steps;
-    carom_compound_child children[3];
+    carom_compound_child children[8];
     double hull[8 * 3];
+    /* level geometry (make_terrain, make_patches): the defs point here */
+    carom_mesh_def mesh;
+    carom_heightfield_def field;
+    double vertices[3 * 121], heights[121];
+    int triangles[6 * 100], holes[2];
 } scene;
 
 /* One body's state read back: position, orientation, velocities. */
@@ -216,6 +224,186 @@ static void make_fast(scene *s)
     plate->orientation = (carom_quat){cos(0.26), sin(0.26), 0, 0};
     plate->linear_velocity = vec(0, 0, -200);
     plate->angular_velocity = vec(0, 30, 0);
+}
+
+/* Level geometry (issue #18): a bumpy terrain of 10 x 10 m, a triangle mesh
+ * with random diagonals or a height field of the same heights with two
+ * holes, here at an offset from the origin, with a mix dropped on it: boxes,
+ * thin plates, spheres, capsules, cylinders, hulls and compounds, some
+ * spinning, some fired down at 20 m/s. */
+enum { GROUND_MESH, GROUND_FIELD };
+static double terrain_height(int i, int j)
+{
+    return 0.12 * sin(0.9 * i) * cos(0.7 * j) + 0.03 * ((i * 5 + j * 3) % 4);
+}
+
+static void make_terrain(scene *s, int ground, carom_vec3 at)
+{
+    memset(s, 0, sizeof *s);
+    s->steps = 150;
+    uint64_t seed = 0x8c6d5e4f3a2b1c0dull;
+    enum { N = 10 };
+    if (ground == GROUND_MESH) {
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) {
+                double *p = s->vertices + 3 * (j * (N + 1) + i);
+                p[0] = i - 0.5 * N;
+                p[1] = j - 0.5 * N;
+                p[2] = terrain_height(i, j);
+            }
+        int k = 0;
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                int a = j * (N + 1) + i, b = a + 1, c = a + N + 2, d = a + N + 1;
+                int q[2][6] = {{a, b, c, a, c, d}, {a, b, d, b, c, d}};
+                memcpy(s->triangles + k, q[rnd(&seed) < 0.5], sizeof q[0]);
+                k += 6;
+            }
+        s->mesh = carom_mesh_def_default();
+        s->mesh.vertices = s->vertices;
+        s->mesh.vertex_count = (N + 1) * (N + 1);
+        s->mesh.triangles = s->triangles;
+        s->mesh.triangle_count = 2 * N * N;
+        carom_body_def *g = push(s);
+        g->type = CAROM_BODY_STATIC;
+        g->shape.type = CAROM_SHAPE_MESH;
+        g->mesh = &s->mesh;
+        g->position = at;
+        g->friction = 0.6;
+    } else {
+        for (int j = 0; j <= N; j++)
+            for (int i = 0; i <= N; i++) s->heights[j * (N + 1) + i] = terrain_height(i, j);
+        s->holes[0] = 2 * N + 7;
+        s->holes[1] = 6 * N + 1;
+        s->field = carom_heightfield_def_default();
+        s->field.heights = s->heights;
+        s->field.rows = s->field.columns = N + 1;
+        s->field.cell_x = s->field.cell_y = 1.0;
+        s->field.holes = s->holes;
+        s->field.hole_count = 2;
+        carom_body_def *g = push(s);
+        g->type = CAROM_BODY_STATIC;
+        g->shape.type = CAROM_SHAPE_HEIGHTFIELD;
+        g->heightfield = &s->field;
+        g->position = at;
+        g->friction = 0.6;
+    }
+    static const double cube[8 * 3] = {-0.3, -0.3, -0.3, 0.3, -0.3, -0.3, -0.3, 0.3, -0.3, 0.3, 0.3, -0.3,
+                                       -0.3, -0.3, 0.4,  0.3, -0.3, 0.2,  -0.3, 0.3, 0.3,  0.2, 0.2, 0.3};
+    memcpy(s->hull, cube, sizeof cube);
+    s->children[0] = carom_compound_child_default(carom_shape_sphere(0.2));
+    s->children[0].position = vec(-0.4, 0, 0);
+    s->children[1] = carom_compound_child_default(carom_shape_capsule(0.1, 0.2));
+    s->children[1].position = vec(0.4, 0, 0);
+    s->children[1].friction = 0.2;
+    s->children[2] = carom_compound_child_default(carom_shape_box(0.4, 0.05, 0.05));
+    s->children[2].density = 3000;
+    for (int k = 0; k < 32; k++) {
+        carom_shape_def sh;
+        switch (k % 8) {
+        case 0: sh = carom_shape_box(0.3, 0.2, 0.25); break;
+        case 1: sh = carom_shape_sphere(0.25); break;
+        case 2: sh = carom_shape_capsule(0.12, 0.3); break;
+        case 3: sh = carom_shape_cylinder(0.2, 0.2); break;
+        case 4: sh = carom_shape_hull(s->hull, 8); break;
+        case 5: sh = carom_shape_box(0.4, 0.3, 0.01); break;
+        case 6: sh = carom_shape_capsule(0.05, 0.4); break;
+        default: sh = carom_shape_sphere(0.3); break;
+        }
+        carom_vec3 p = vec(at.x - 3.5 + (k % 8), at.y - 3 + 2 * (k / 8), at.z + 1 + 0.3 * (k % 3) + 0.2 * rnd(&seed));
+        carom_body_def *d = push_dynamic(s, sh, p, 0.5 + rnd(&seed), 0.3 + 0.5 * rnd(&seed));
+        if (k % 8 == 7 && k % 16 == 15) {
+            d->shape.type = CAROM_SHAPE_COMPOUND;
+            d->children = s->children;
+            d->child_count = 3;
+        }
+        double a = 3 * rnd(&seed);
+        carom_vec3 axis = vec(rnd(&seed) - 0.5, rnd(&seed) - 0.5, rnd(&seed) - 0.5);
+        double len = sqrt(axis.x * axis.x + axis.y * axis.y + axis.z * axis.z);
+        d->orientation = (carom_quat){cos(a / 2), sin(a / 2) * axis.x / len, sin(a / 2) * axis.y / len, sin(a / 2) * axis.z / len};
+        d->linear_velocity = vec(2 * rnd(&seed) - 1, 2 * rnd(&seed) - 1, k % 5 == 0 ? -20 : 0);
+        d->angular_velocity = vec(4 * rnd(&seed) - 2, 4 * rnd(&seed) - 2, 4 * rnd(&seed) - 2);
+        d->restitution = k % 3 == 0 ? 0.3 : 0.0;
+    }
+}
+
+/* Separate statics (issue #18's floors): 3 x 3 patches of 2 x 2 m, each its
+ * own flat mesh (its own diagonals), beside 1 m box tiles, and a box, a
+ * sphere, a capsule, a cylinder and compounds sliding and rolling across
+ * the seams at angles. */
+static void make_patches(scene *s)
+{
+    memset(s, 0, sizeof *s);
+    s->steps = 150;
+    /* one patch: 2 x 2 cells of 1 m about its origin; the body's position places it */
+    for (int j = 0; j <= 2; j++)
+        for (int i = 0; i <= 2; i++) {
+            double *p = s->vertices + 3 * (j * 3 + i);
+            p[0] = i - 1.0;
+            p[1] = j - 1.0;
+            p[2] = 0;
+        }
+    int k = 0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int a = j * 3 + i, b = a + 1, c = a + 4, d = a + 3;
+            int q[2][6] = {{a, b, c, a, c, d}, {a, b, d, b, c, d}};
+            memcpy(s->triangles + k, q[(i + j) % 2], sizeof q[0]);
+            k += 6;
+        }
+    s->mesh = carom_mesh_def_default();
+    s->mesh.vertices = s->vertices;
+    s->mesh.vertex_count = 9;
+    s->mesh.triangles = s->triangles;
+    s->mesh.triangle_count = 8;
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            carom_body_def *g = push(s);
+            g->type = CAROM_BODY_STATIC;
+            g->shape.type = CAROM_SHAPE_MESH;
+            g->mesh = &s->mesh;
+            g->position = vec(2 * i - 2, 2 * j - 2, 0);
+            g->friction = 0.3;
+        }
+    for (int j = 0; j < 6; j++)
+        for (int i = 0; i < 3; i++) push_static(s, carom_shape_box(0.5, 0.5, 0.5), vec(3.5 + i, j - 2.5, -0.5), 0.3);
+    s->children[0] = carom_compound_child_default(carom_shape_sphere(0.2));
+    s->children[0].position = vec(0, -0.3, 0);
+    s->children[1] = carom_compound_child_default(carom_shape_sphere(0.2));
+    s->children[1].position = vec(0, 0.3, 0);
+    s->children[2] = carom_compound_child_default(carom_shape_cylinder(0.05, 0.3));
+    s->children[2].orientation = (carom_quat){cos(PI_ / 4), sin(PI_ / 4), 0, 0};
+    for (int c = 0; c < 4; c++) {
+        s->children[3 + c] = carom_compound_child_default(carom_shape_box(0.05, 0.05, 0.2));
+        s->children[3 + c].position = vec(c % 2 ? 0.35 : -0.35, c / 2 ? 0.25 : -0.25, -0.1);
+        s->children[3 + c].friction = 0.2 + 0.1 * c;
+    }
+    s->children[7] = carom_compound_child_default(carom_shape_box(0.45, 0.35, 0.03));
+    s->children[7].position = vec(0, 0, 0.13);
+    struct { carom_shape_def sh; carom_vec3 p, v, w; } m[] = {
+        {carom_shape_box(0.3, 0.3, 0.3), {-2.7, -2.2, 0.3}, {5, 2, 0}, {0, 0, 0}},
+        {carom_shape_sphere(0.3), {-2.8, 0.1, 0.3}, {2, 0.5, 0}, {0, 8, 0}},
+        {carom_shape_capsule(0.15, 0.3), {-2.5, 1.8, 0.15}, {2, -0.5, 0}, {0, 0, 1}},
+        {carom_shape_cylinder(0.25, 0.2), {-2.6, -1.1, 0.25}, {2, 0.6, 0}, {0, 0, 0}},
+        {carom_shape_sphere(0.25), {0.1, -2.6, 0.25}, {0.5, 2, 0}, {-8, 2, 0}},
+    };
+    for (unsigned i = 0; i < sizeof m / sizeof m[0]; i++) {
+        carom_body_def *d = push_dynamic(s, m[i].sh, m[i].p, 1.0, 0.3);
+        d->linear_velocity = m[i].v;
+        d->angular_velocity = m[i].w;
+        if (m[i].sh.type == CAROM_SHAPE_CYLINDER || m[i].sh.type == CAROM_SHAPE_CAPSULE) d->orientation = (carom_quat){cos(PI_ / 4), sin(PI_ / 4), 0, 0};
+    }
+    carom_body_def *bell = push_dynamic(s, carom_shape_sphere(0.2), vec(-2.4, 0.9, 0.2), 2.0, 0.3);
+    bell->shape.type = CAROM_SHAPE_COMPOUND;
+    bell->children = s->children;
+    bell->child_count = 3;
+    bell->linear_velocity = vec(2, 0, 0);
+    carom_body_def *table = push_dynamic(s, carom_shape_sphere(0.2), vec(-1.2, 1.2, 0.31), 0, 0.3);
+    table->shape.type = CAROM_SHAPE_COMPOUND;
+    table->children = s->children + 3;
+    table->child_count = 5;
+    table->linear_velocity = vec(3, 1.5, 0);
+    table->angular_velocity = vec(0, 0, 2);
 }
 
 static int scene_index(const carom_body_id *ids, int n, carom_body_id id)
@@ -447,6 +635,43 @@ static void test_wake_any_order(void **state)
     assert_int_equal(compare_orders(&s, "wake"), 0);
 }
 
+
+static void test_terrain_mesh_any_order(void **state)
+{
+    (void)state;
+    static scene s;
+    make_terrain(&s, GROUND_MESH, vec(0, 0, 0));
+    assert_int_equal(compare_orders(&s, "terrain mesh"), 0);
+}
+
+static void test_terrain_field_any_order(void **state)
+{
+    (void)state;
+    static scene s;
+    make_terrain(&s, GROUND_FIELD, vec(0, 0, 0));
+    assert_int_equal(compare_orders(&s, "terrain field"), 0);
+}
+
+/* The same terrains 1e4 m out (rounding differs there: the order rule must
+ * not depend on the size of the coordinates). */
+static void test_terrain_far_any_order(void **state)
+{
+    (void)state;
+    static scene s;
+    make_terrain(&s, GROUND_MESH, vec(1e4, -3e3, 50));
+    assert_int_equal(compare_orders(&s, "terrain mesh 1e4 m out"), 0);
+    make_terrain(&s, GROUND_FIELD, vec(-1e4, 2e3, -50));
+    assert_int_equal(compare_orders(&s, "terrain field 1e4 m out"), 0);
+}
+
+static void test_patches_any_order(void **state)
+{
+    (void)state;
+    static scene s;
+    make_patches(&s);
+    assert_int_equal(compare_orders(&s, "mesh patches and tiles"), 0);
+}
+
 /* A snapshot keeps which body of each pair is A (docs/snapshot.md: A's id
  * is written first in each contact record; format 7 had record bit
  * 131072): the mixed scene built in reverse, so that many pairs' A is
@@ -503,6 +728,10 @@ int main(void)
         cmocka_unit_test(test_mixed_any_order),
         cmocka_unit_test(test_wake_any_order),
         cmocka_unit_test(test_fast_any_order),
+        cmocka_unit_test(test_terrain_mesh_any_order),
+        cmocka_unit_test(test_terrain_field_any_order),
+        cmocka_unit_test(test_terrain_far_any_order),
+        cmocka_unit_test(test_patches_any_order),
         cmocka_unit_test(test_snapshot_keeps_body_a),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
