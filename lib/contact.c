@@ -23,6 +23,12 @@ static uint32_t hash_key(uint64_t k, uint32_t sub)
 
 static uint32_t contact_hash(const contact *c) { return hash_key(pair_key(c->id_a, c->id_b), c->sub); }
 
+/* Whether a map of `capacity` slots is too full to hold `count` contacts:
+ * past 3/4 (linear probing stays short there: a hit's chain averages 2.5
+ * slots, a miss's 8.5; at 1/2 the 131,805 contacts of the 50,000-body grid
+ * took 524,288 slots, 4 MB, instead of 262,144). */
+static int map_full(int count, int capacity) { return (int64_t)count * 4 > (int64_t)capacity * 3; }
+
 static int map_init(pair_map *m, int capacity)
 {
     m->hashes = malloc((size_t)capacity * sizeof *m->hashes);
@@ -242,21 +248,31 @@ int contact_append(contact_set *cs, int a, int b, uint32_t sub)
     return i;
 }
 
-/* A pair's key and index, gathered in one sequential pass over the
+/* A pair's hash and index, gathered in one sequential pass over the
  * contacts: placed in the order of their home slots, the contacts
- * themselves (136 bytes each) would be read at random, a cache miss each
- * (most of the map's build time in a 10,000-body restore). */
+ * themselves (128 bytes each) would be read at random, a cache miss each
+ * (most of the map's build time in a 10,000-body restore). Only a slot of
+ * the same hash sends the insert to the two contacts (same_pair): a repeated
+ * pair, or one in 2^32 chance a slot. */
 typedef struct pair_record {
-    uint32_t hash, sub;
-    int a, b, index;
+    uint32_t hash;
+    int index;
 } pair_record;
+
+/* Whether two contacts hold the same pair (in either order) and sub. */
+static int same_pair(const contact *c, const contact *d)
+{
+    int clo = c->id_a < c->id_b ? c->id_a : c->id_b, chi = c->id_a < c->id_b ? c->id_b : c->id_a;
+    int dlo = d->id_a < d->id_b ? d->id_a : d->id_b, dhi = d->id_a < d->id_b ? d->id_b : d->id_a;
+    return clo == dlo && chi == dhi && c->sub == d->sub;
+}
 
 int contact_set_index(contact_set *cs, int *repeated)
 {
     int n = cs->count;
     *repeated = -1;
     int capacity = 64, bits = 6;
-    while ((n + 1) * 2 > capacity) capacity *= 2, bits++;
+    while (map_full(n + 1, capacity)) capacity *= 2, bits++;
     /* buckets by the top (at most 12) bits of the home slot: each bucket's
      * slots span a few cache lines, and start[] stays small */
     int bucket_bits = bits < 12 ? bits : 12, shift = bits - bucket_bits;
@@ -286,19 +302,21 @@ int contact_set_index(contact_set *cs, int *repeated)
         const contact *c = &cs->items[i];
         pair_record *p = &rec[i];
         p->hash = contact_hash(c);
-        p->sub = c->sub;
-        p->a = c->id_a < c->id_b ? c->id_a : c->id_b; /* (map_slot takes the pair as lo, hi) */
-        p->b = c->id_a < c->id_b ? c->id_b : c->id_a;
         p->index = i;
         start[((p->hash & mask) >> shift) + 1]++;
     }
     for (int k = 0; k < (1 << bucket_bits); k++) start[k + 1] += start[k];
     for (int i = 0; i < n; i++) sorted[start[(rec[i].hash & mask) >> shift]++] = rec[i]; /* (stable) */
     pair_map old = cs->map;
-    cs->map = m; /* map_slot reads the set's map */
+    cs->map = m;
     for (int k = 0; k < n; k++) {
         const pair_record *p = &sorted[k];
-        int slot = map_slot(cs, p->hash, p->a, p->b, p->sub);
+        uint32_t slot = p->hash & mask;
+        for (;;) { /* map_slot's walk, the contacts read only where a hash agrees */
+            int v = cs->map.values[slot];
+            if (v < 0 || (cs->map.hashes[slot] == p->hash && same_pair(&cs->items[v], &cs->items[p->index]))) break;
+            slot = (slot + 1) & mask;
+        }
         if (cs->map.values[slot] >= 0) { /* the later of the two repeats the earlier */
             int later = p->index > cs->map.values[slot] ? p->index : cs->map.values[slot];
             if (*repeated < 0 || later < *repeated) *repeated = later;
@@ -317,7 +335,7 @@ int contact_set_index(contact_set *cs, int *repeated)
 /* (a new pair: the caller found none for it) */
 int contact_add_sub(contact_set *cs, int a, int b, uint32_t sub)
 {
-    if ((cs->map.count + 1) * 2 > cs->map.capacity && !map_grow(&cs->map)) return -1;
+    if (map_full(cs->map.count + 1, cs->map.capacity) && !map_grow(&cs->map)) return -1;
     int i = contact_append(cs, a, b, sub);
     if (i >= 0) map_insert(&cs->map, contact_hash(&cs->items[i]), i);
     return i;

@@ -24,9 +24,9 @@ typedef struct manifold {
 /* Per-pair memory kept by the contact cache between steps. Zero it for a new pair. */
 typedef struct collide_cache {
     vec3 normal;         /* last normal (A to B), valid when has_normal */
-    int has_normal;
     int feature;         /* last reference feature (box-box / hull SAT axis), -1 none */
-    int flip;            /* last reference face belonged to B */
+    unsigned char has_normal; /* 0 or 1 (bytes: the cache is 32 bytes and a contact 128) */
+    unsigned char flip;  /* last reference face belonged to B (0 or 1) */
 } collide_cache;
 
 /* Contacts between two convex shapes (sphere, box, capsule, cylinder, hull;
