@@ -120,6 +120,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             d.lock_to_plane = fz_below(&in, 4) == 0;
             d.bullet = fz_bool(&in);
             d.awake = fz_below(&in, 4) != 0;
+            if (getenv("CAROM_FUZZ_TRACE"))
+                fprintf(stderr, "create: type %d shape %d r %.17g hh %.17g he (%.17g %.17g %.17g) n (%.17g %.17g %.17g) off %.17g"
+                        " pos (%.17g %.17g %.17g) v (%.17g %.17g %.17g) w (%.17g %.17g %.17g) mass %.17g density %.17g"
+                        " mu %.17g e %.17g g %.17g qw %.17g pn (%.17g %.17g %.17g) locks %d %d bullet %d awake %d\n",
+                        (int)d.type, (int)d.shape.type, d.shape.radius, d.shape.half_height, d.shape.half_extents.x,
+                        d.shape.half_extents.y, d.shape.half_extents.z, d.shape.normal.x, d.shape.normal.y, d.shape.normal.z,
+                        d.shape.offset, d.position.x, d.position.y, d.position.z, d.linear_velocity.x, d.linear_velocity.y,
+                        d.linear_velocity.z, d.angular_velocity.x, d.angular_velocity.y, d.angular_velocity.z, d.mass,
+                        d.density, d.friction, d.restitution, d.gravity_scale, d.orientation.w, d.plane_normal.x,
+                        d.plane_normal.y, d.plane_normal.z, d.lock_rotation, d.lock_to_plane, d.bullet, d.awake);
             carom_body_id nid = carom_body_create(w, &d);
             if (carom_body_id_is_null(nid)) st = CAROM_ERROR_INVALID_ARGUMENT;
             else if (m.nlive < MAX_LIVE) m.live[m.nlive++] = nid;

@@ -91,7 +91,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fuzz_input in = {data, size, 0};
     static const char *const presets[] = {"fast", "default", "accurate"};
     carom_world_def wd = carom_world_def_default();
-    carom_world_def_apply_preset(&wd, presets[fz_below(&in, 3)]);
+    const char *preset = presets[fz_below(&in, 3)];
+    carom_world_def_apply_preset(&wd, preset);
     wd.enable_sleep = fz_bool(&in);
     wd.enable_continuous = fz_below(&in, 4) != 0;
     wd.enable_friction = fz_below(&in, 4) != 0;
@@ -180,6 +181,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                     d.position.y, d.position.z, d.linear_velocity.x, d.linear_velocity.y, d.linear_velocity.z,
                     d.angular_velocity.x, d.angular_velocity.y, d.angular_velocity.z, d.mass, d.density, d.bullet,
                     d.lock_rotation, d.lock_to_plane, carom_body_id_is_null(m->id) ? carom_world_last_error(w) : "ok");
+        if (getenv("CAROM_FUZZ_TRACE")) {
+            fprintf(stderr, "  exact: pos %.17g %.17g %.17g v %.17g %.17g %.17g w %.17g %.17g %.17g mass %.17g rho %.17g mu %.17g e %.17g"
+                    " damp %.17g gs %.17g r %.17g hh %.17g he %.17g %.17g %.17g\n  points", d.position.x, d.position.y, d.position.z,
+                    d.linear_velocity.x, d.linear_velocity.y, d.linear_velocity.z, d.angular_velocity.x, d.angular_velocity.y,
+                    d.angular_velocity.z, d.mass, d.density, d.friction, d.restitution, d.linear_damping, d.gravity_scale,
+                    d.shape.radius, d.shape.half_height, d.shape.half_extents.x, d.shape.half_extents.y, d.shape.half_extents.z);
+            for (int k = 0; d.shape.type == CAROM_SHAPE_HULL && k < 3 * d.shape.point_count; k++) fprintf(stderr, " %.17g", m->points[k]);
+            fprintf(stderr, "\n");
+        }
         if (!carom_body_id_is_null(m->id) && d.type == CAROM_BODY_DYNAMIC) count++;
     }
     static const double dts[] = {1.0 / 60, 1.0 / 15, 1.0 / 240, 1.0 / 1000};
@@ -187,9 +197,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     int steps = 5 + (int)fz_below(&in, 40);
     if (getenv("CAROM_FUZZ_TRACE"))
         fprintf(stderr, "world: preset %s sleep %d ccd %d friction %d model %d correction %d g (%g %g %g) vmax %g hz %g; "
-                "plane n (%g %g %g) off %g; dt %g x %d\n", "?", wd.enable_sleep, wd.enable_continuous, wd.enable_friction,
+                "plane n (%g %g %g) off %g; dt %g x %d\n", preset, wd.enable_sleep, wd.enable_continuous, wd.enable_friction,
                 (int)wd.contact_model, (int)wd.position_correction, wd.gravity.x, wd.gravity.y, wd.gravity.z,
                 wd.max_linear_speed, wd.contact_hertz, n.x, n.y, n.z, off, dt, steps);
+    if (getenv("CAROM_FUZZ_TRACE"))
+        fprintf(stderr, "  exact: n %.17g %.17g %.17g off %.17g dt %.17g hz %.17g vmax %.17g g %.17g %.17g %.17g substeps %d iters %d"
+                " warm %d shock %d restitution %d\n", n.x, n.y, n.z, off, dt, wd.contact_hertz, wd.max_linear_speed,
+                wd.gravity.x, wd.gravity.y, wd.gravity.z, wd.substeps, wd.iterations, wd.warm_starting,
+                wd.shock_propagation, wd.enable_restitution);
     /* a soft contact of frequency f holds a body a sag g / (2 pi f)^2 deep (and
      * the harness picks frequencies down to 1e-3 Hz): that much is allowed.
      * The step caps f at a quarter of the sub-step rate, 1 / (4 h)
