@@ -17,6 +17,22 @@
 
 #define MAX_COORDINATE RANGE_COORDINATE_MAX
 
+/* A moving body's shape spans enough ulps of its coordinates (ranges.h). */
+static int resolved_at(const shape *sh, vec3 p)
+{
+    double far = dmax(fabs(p.x), dmax(fabs(p.y), fabs(p.z)));
+    return shape_thickness(sh) >= RANGE_THICKNESS_PER_COORDINATE * far;
+}
+
+static carom_status fail_unresolved(carom_world *w, const char *fn, const shape *sh, vec3 p)
+{
+    double far = dmax(fabs(p.x), dmax(fabs(p.y), fabs(p.z)));
+    return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT,
+                      "%s: a moving body %g m thick (half) at %g m from the origin is below what the coordinates resolve "
+                      "there: at least 1e-13 of them, %g m",
+                      fn, shape_thickness(sh), far, RANGE_THICKNESS_PER_COORDINATE * far);
+}
+
 static vec3 to_v3(carom_vec3 v) { return v3(v.x, v.y, v.z); }
 static carom_vec3 from_v3(vec3 v) { carom_vec3 r = {v.x, v.y, v.z}; return r; }
 static int finite_c(carom_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
@@ -281,6 +297,11 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
         shape_free_data(&sh);
         return null_id;
     }
+    if (d.type != CAROM_BODY_STATIC && !resolved_at(&sh, to_v3(d.position))) {
+        fail_unresolved(w, "body_create", &sh, to_v3(d.position));
+        shape_free_data(&sh);
+        return null_id;
+    }
     if (!body_store_reserve(&w->bodies)) {
         shape_free_data(&sh);
         world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "body_create: out of memory");
@@ -318,7 +339,8 @@ CAROM_API carom_body_id carom_body_create(carom_world *w, const carom_body_def *
     s->linear_damping[slot] = d.linear_damping;
     s->angular_damping[slot] = d.angular_damping;
     s->gravity_scale[slot] = d.gravity_scale;
-    s->plane_normal[slot] = v3_normalize(to_v3(d.plane_normal));
+    /* read only with lock_to_plane: an unread value (even a NaN) stays out of the state */
+    s->plane_normal[slot] = d.lock_to_plane ? v3_normalize(to_v3(d.plane_normal)) : v3(0, 1, 0);
     s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
     /* created asleep: already rested for the sleep time, so the first step
      * does not wake it (as set_awake(false) leaves it) */
@@ -518,6 +540,8 @@ CAROM_API carom_status carom_body_set_position(carom_world *w, carom_body_id id,
     if (!finite_c(p) || fabs(p.x) > MAX_COORDINATE || fabs(p.y) > MAX_COORDINATE || fabs(p.z) > MAX_COORDINATE)
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_position: position (%g, %g, %g) must be finite with |x| <= 1e12 m", p.x, p.y, p.z);
     body_store *s = &w->bodies;
+    if (s->type[slot] != CAROM_BODY_STATIC && !resolved_at(&s->shapes[slot], to_v3(p)))
+        return fail_unresolved(w, "body_set_position", &s->shapes[slot], to_v3(p));
     s->center[slot] = v3_add(to_v3(p), q_rotate(s->rotation[slot], s->local_center[slot]));
     s->previous_origin[slot] = to_v3(p); /* a teleport: nothing to interpolate across */
     if (s->flags[slot] & BODY_LOCK_PLANE) s->plane_offset[slot] = v3_dot(s->plane_normal[slot], s->center[slot]);
@@ -592,6 +616,10 @@ CAROM_API carom_status carom_body_set_type(carom_world *w, carom_body_id id, car
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a plane must stay static");
     if (type == CAROM_BODY_DYNAMIC && (s->shapes[slot].type == SHAPE_MESH || s->shapes[slot].type == SHAPE_HEIGHTFIELD))
         return world_fail(w, CAROM_ERROR_UNSUPPORTED, "body_set_type: a mesh or heightfield cannot be dynamic");
+    if (type != CAROM_BODY_STATIC) {
+        vec3 origin = v3_sub(s->center[slot], q_rotate(s->rotation[slot], s->local_center[slot]));
+        if (!resolved_at(&s->shapes[slot], origin)) return fail_unresolved(w, "body_set_type", &s->shapes[slot], origin);
+    }
     if (type == CAROM_BODY_DYNAMIC) {
         mass_props mp = {s->mass[slot], s->local_center[slot], s->inertia_local[slot]};
         if (!(s->mass[slot] > 0)) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_set_type: body has no mass");

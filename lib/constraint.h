@@ -117,6 +117,19 @@ static inline double locked_inv_mass(double inv_mass, vec3 d, vec3 l)
     return inv_mass * (1.0 - dl * dl);
 }
 
+/* A row the locks leave with under ROW_BLOCKED_SHARE of the bodies' free 1/m
+ * (the sum of their unlocked inverse masses) is blocked and gets no impulse:
+ * its 1/k would be over 1e6 times the free response (RANGE_IMPULSE_MAX's
+ * margin), from a lock normal within 0.06 deg of the row. A contact normal
+ * along a locked direction leaves only rounding, about 1e-32 of the free 1/m,
+ * and 1/k of that stored a warm-start impulse of 1.2e33 N s that no snapshot
+ * could restore. Without locks k >= the free 1/m: no row is blocked. */
+#define ROW_BLOCKED_SHARE 1e-6
+static inline double row_mass(double k, double free_inv_mass)
+{
+    return k > ROW_BLOCKED_SHARE * free_inv_mass ? 1.0 / k : 0.0;
+}
+
 /* A plane-locked body's velocity kept in its plane (l = 0: unchanged). */
 static inline vec3 keep_in_plane(vec3 v, vec3 l) { return v3_madd(v, -v3_dot(v, l), l); }
 

@@ -395,7 +395,8 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
     /* the linear share of each row's inverse effective mass: a plane-locked
      * body's 1/m counts only the row's part in its plane (its inverse inertia
      * is already the reduced n n^T / (n.I n)) */
-    double lin_n = A->inv_mass + B->inv_mass, lin_1 = lin_n, lin_2 = lin_n;
+    double free_inv_mass = A->inv_mass + B->inv_mass;
+    double lin_n = free_inv_mass, lin_1 = lin_n, lin_2 = lin_n;
     if (c->locked) {
         vec3 la = constraint_lock_a(c), lb = constraint_lock_b(c);
         lin_n = locked_inv_mass(A->inv_mass, c->n, la) + locked_inv_mass(B->inv_mass, c->n, lb);
@@ -427,9 +428,9 @@ double contact_prepare(contact_constraint *c, const step_context *ctx)
         double kn = lin_n + v3_dot(r->ia_n, r->ra_n) + v3_dot(r->ib_n, r->rb_n);
         double k1 = lin_1 + v3_dot(r->ia_t[0], r->ra_t[0]) + v3_dot(r->ib_t[0], r->rb_t[0]);
         double k2 = lin_2 + v3_dot(r->ia_t[1], r->ra_t[1]) + v3_dot(r->ib_t[1], r->rb_t[1]);
-        r->normal_mass = kn > 0 ? 1.0 / kn : 0.0;
-        r->tangent_mass[0] = k1 > 0 ? 1.0 / k1 : 0.0;
-        r->tangent_mass[1] = k2 > 0 ? 1.0 / k2 : 0.0;
+        r->normal_mass = row_mass(kn, free_inv_mass);
+        r->tangent_mass[0] = row_mass(k1, free_inv_mass);
+        r->tangent_mass[1] = row_mass(k2, free_inv_mass);
         q->base_separation = mp->separation;
         p->relative_velocity = contact_approach_velocity(impulse_relative_normal_velocity(B, A, q->rb, q->ra, c->n),
                                                          c->gravity_closing, mp->separation);
@@ -750,7 +751,7 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
         double k = fa * (locked_inv_mass(A->inv_mass, n, lock_a) + v3_dot(ra_n, ia_n)) +
                    fb * (locked_inv_mass(B->inv_mass, n, lock_b) + v3_dot(rb_n, ib_n));
         shock_normal[i] = 0.0;
-        if (k <= 0) continue;
+        if (!(row_mass(k, fa * A->inv_mass + fb * B->inv_mass) > 0.0)) continue;
         /* rigid against an immovable lower body, with the soft push-out rate */
         double bias = 0.0;
         if (s > 0.0) bias = CONTACT_SPECULATIVE_BIAS(s, ctx->inv_h);
@@ -780,7 +781,7 @@ void contact_solve_shock(contact_constraint *c, const step_context *ctx, int use
             vec3 rat = v3_cross(q->ra, t[j]), rbt = v3_cross(q->rb, t[j]);
             double k = fa * (locked_inv_mass(A->inv_mass, t[j], lock_a) + v3_dot(rat, m3_mulv(A->inv_inertia, rat))) +
                        fb * (locked_inv_mass(B->inv_mass, t[j], lock_b) + v3_dot(rbt, m3_mulv(B->inv_inertia, rbt)));
-            nw[j] = k > 0 ? -v3_dot(vp, t[j]) / k : 0.0;
+            nw[j] = row_mass(k, fa * A->inv_mass + fb * B->inv_mass) > 0.0 ? -v3_dot(vp, t[j]) / k : 0.0;
         }
         /* Coulomb on the total: what the regular pass used plus this pass */
         double o1 = p->tangent_impulse[0], o2 = p->tangent_impulse[1];

@@ -141,7 +141,7 @@ static void pair_geometry(carom_world *w, const contact_constraint *cc, const im
         double k = impulse_inverse_effective_mass(B, A, ip->rb[j], ip->ra[j], m.normal) -
                    (A->inv_mass - locked_inv_mass(A->inv_mass, m.normal, constraint_lock_a(c))) -
                    (B->inv_mass - locked_inv_mass(B->inv_mass, m.normal, constraint_lock_b(c)));
-        ip->normal_mass[j] = k > 0.0 ? 1.0 / k : 0.0;
+        ip->normal_mass[j] = row_mass(k, A->inv_mass + B->inv_mass);
     }
 }
 

@@ -24,6 +24,17 @@
  * offset n.c has the same bound. */
 #define RANGE_STATE_COORDINATE_MAX 1e18
 #define RANGE_LENGTH_MIN 1e-6       /* m: radius, half extent, half height */
+/* A moving body's half thickness (shape_thickness) over the largest
+ * |coordinate| of its position: contacts are found in world coordinates,
+ * where a point carries half an ulp of them (1.1e-16 |x|) and a sub-step's
+ * motion is rounded to it. Measured on a tilted plane at 1e12 m (ulp 1.2e-4
+ * m), sliding 10 s, every preset, dt 1/12 to 1/1000: any sphere sank up to
+ * 2.2 mm (0.07 mm at the origin); a 1 cm one 8.7 mm, a 1 mm one 3.5 mm
+ * past its radius, a fuzzed 3.45 um hull 0.1 m (its impulses went into spin
+ * about lever arms 35 times its size). At 1e-13 (10 cm there, 450 ulps) the
+ * overlap stays within 2.2 % of the thickness. It binds only beyond 1e7 m
+ * (there 1e-6 m, the smallest length). */
+#define RANGE_THICKNESS_PER_COORDINATE 1e-13
 #define RANGE_LENGTH_MAX 1e6        /* m: the same, and |hull point component| */
 #define RANGE_MASS_MIN 1e-9         /* kg: a dynamic body's mass, given or from density */
 #define RANGE_MASS_MAX 1e15         /* kg */

@@ -230,6 +230,28 @@ vec3 shape_support_local(const shape *s, vec3 d)
     }
 }
 
+double shape_thickness(const shape *s)
+{
+    switch (s->type) {
+    case SHAPE_SPHERE: case SHAPE_CAPSULE: return s->radius;
+    case SHAPE_BOX: return dmin(s->half_extents.x, dmin(s->half_extents.y, s->half_extents.z));
+    case SHAPE_CYLINDER: return dmin(s->radius, s->half_height);
+    case SHAPE_HULL: {
+        double m = 1e300;
+        for (int i = 0; i < s->hull->face_count; i++)
+            m = dmin(m, s->hull->faces[i].offset - v3_dot(s->hull->faces[i].normal, s->hull->centroid));
+        return m > 0 ? m : 0.0;
+    }
+    case SHAPE_COMPOUND: {
+        /* the thinnest child can pass through first */
+        double m = 1e300;
+        for (int i = 0; i < s->compound->count; i++) m = dmin(m, shape_thickness(&s->compound->children[i]));
+        return m;
+    }
+    default: return 1e300;
+    }
+}
+
 double shape_bounding_radius(const shape *s)
 {
     switch (s->type) {

@@ -66,6 +66,10 @@ aabb shape_aabb(const shape *s, xform t);
 /* Support point in the body frame: the point of the shape farthest along dir
  * (dir need not be unit; a zero dir returns some point of the shape). */
 vec3 shape_support_local(const shape *s, vec3 dir);
+/* Half the thinnest width of the shape: how far it may move in a step before
+ * it can pass through others (continuous collision), and the size the
+ * coordinates must resolve (ranges.h); 1e300 for planes, meshes and fields. */
+double shape_thickness(const shape *s);
 /* Bounding radius about the body origin (used for continuous collision). */
 double shape_bounding_radius(const shape *s);
 /* Ray cast against a shape in its body frame: origin o, direction d (not unit),

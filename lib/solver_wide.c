@@ -1013,17 +1013,17 @@ LANE_INLINE void gather_point(const lane_manifolds *lm, int i, const contact_poi
 }
 
 LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wide_point *p, const lane_t ra[3],
-                              const lane_t rb[3], const lane_t lin[3], int friction)
+                              const lane_t rb[3], const lane_t lin[3], const lane_t *blocked, int friction)
 {
-    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
+    const lane_t zero = SPLAT(0.0), one = SPLAT(1.0), floor = *blocked;
     CROSS(p->ra_n, ra, wb->n);
     CROSS(p->rb_n, rb, wb->n);
     MAT_VEC(p->ia_n, lm->ia, p->ra_n);
     MAT_VEC(p->ib_n, lm->ib, p->rb_n);
     if (!friction) { /* no tangent rows: only the normal's mass */
         lane_t kn = lin[0] + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
-        lane_t ikn = one / SELECT_LANES(kn > zero, kn, one);
-        p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
+        lane_t ikn = one / SELECT_LANES(kn > floor, kn, one);
+        p->normal_mass = SELECT_LANES(kn > floor, ikn, zero);
         return;
     }
     CROSS(p->ra_t[0], ra, wb->t1);
@@ -1037,11 +1037,11 @@ LANE_INLINE void prepare_rows(const wide_batch *wb, const lane_manifolds *lm, wi
     lane_t kn = lin[0] + DOT3(p->ia_n, p->ra_n) + DOT3(p->ib_n, p->rb_n);
     lane_t k1 = lin[1] + DOT3(p->ia_t[0], p->ra_t[0]) + DOT3(p->ib_t[0], p->rb_t[0]);
     lane_t k2 = lin[2] + DOT3(p->ia_t[1], p->ra_t[1]) + DOT3(p->ib_t[1], p->rb_t[1]);
-    lane_t ikn = one / SELECT_LANES(kn > zero, kn, one), ik1 = one / SELECT_LANES(k1 > zero, k1, one),
-           ik2 = one / SELECT_LANES(k2 > zero, k2, one);
-    p->normal_mass = SELECT_LANES(kn > zero, ikn, zero);
-    p->tangent_mass[0] = SELECT_LANES(k1 > zero, ik1, zero);
-    p->tangent_mass[1] = SELECT_LANES(k2 > zero, ik2, zero);
+    lane_t ikn = one / SELECT_LANES(kn > floor, kn, one), ik1 = one / SELECT_LANES(k1 > floor, k1, one),
+           ik2 = one / SELECT_LANES(k2 > floor, k2, one);
+    p->normal_mass = SELECT_LANES(kn > floor, ikn, zero);
+    p->tangent_mass[0] = SELECT_LANES(k1 > floor, ik1, zero);
+    p->tangent_mass[1] = SELECT_LANES(k2 > floor, ik2, zero);
 }
 
 /* Point i's warm-start impulses, scaled by warm (empty lanes read zeros). */
@@ -1100,13 +1100,14 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm, 1);
     /* the linear share of each row's inverse effective mass (n, t1, t2) */
-    lane_t lin[3];
+    lane_t lin[3], floor = SPLAT(0.0); /* rows blocked at or below floor (row_mass, constraint.h) */
     lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
     if (lk) {
         const lane_t one = SPLAT(1.0);
         lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, lk->a) + LOCKED_INV_MASS(lm.mb, wb->n, lk->b);
         lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t1, lk->b);
         lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, lk->a) + LOCKED_INV_MASS(lm.mb, wb->t2, lk->b);
+        floor = SPLAT(ROW_BLOCKED_SHARE) * (lm.ma + lm.mb);
     }
     double deepest = 0.0;
     for (int i = 0; i < wb->count; i++) {
@@ -1114,7 +1115,7 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
         const contact_point_state *st[LANES];
         lane_t ra[3], rb[3], sep;
         gather_point(&lm, i, st, ra, rb, &sep);
-        prepare_rows(wb, &lm, p, ra, rb, lin, friction);
+        prepare_rows(wb, &lm, p, ra, rb, lin, &floor, friction);
         p->base_separation = sep;
         /* normal velocity before solving: n . ((vB + wB x rB) - (vA + wA x rA)) */
         lane_t wxa[3], wxb[3];
@@ -1129,8 +1130,11 @@ LANE_INLINE double prepare_batch(const wide_batch *wb, wide_point *pts, contact_
     return deepest;
 }
 
-/* The effective mass 1 / k of a row, 0 where k is not positive. */
-#define ROW_MASS(k) SELECT_LANES((k) > zero, one / SELECT_LANES((k) > zero, (k), one), zero)
+/* The effective mass 1 / k of a row, 0 where k is not above floor: zero,
+ * or with a body locked to a plane the share of the free 1/m below which
+ * the row is blocked (row_mass, constraint.h). */
+#define ROW_MASS_ABOVE(k, floor) SELECT_LANES((k) > (floor), one / SELECT_LANES((k) > (floor), (k), one), zero)
+#define ROW_MASS(k) ROW_MASS_ABOVE(k, zero)
 
 /* A spinless batch's points: each row's mass is its linear share alone
  * (the angular ones were zeros), the same at every point of a manifold. */
@@ -1140,7 +1144,7 @@ LANE_INLINE double prepare_batch_l(const wide_batch *wb, wide_lpoint *pts, conta
     const lane_t zero = SPLAT(0.0), one = SPLAT(1.0);
     lane_manifolds lm;
     gather_manifolds(wb, cc, bodies, &lm, 0);
-    lane_t lin[3];
+    lane_t lin[3], floor = zero;
     lin[0] = lin[1] = lin[2] = lm.ma + lm.mb;
     if (pl) { /* some body locked to a plane: the rows' directions in each plane */
         IN_PLANE(pl->na, wb->n, pl->la);
@@ -1152,11 +1156,12 @@ LANE_INLINE double prepare_batch_l(const wide_batch *wb, wide_lpoint *pts, conta
         lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, pl->la) + LOCKED_INV_MASS(lm.mb, wb->n, pl->lb);
         lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t1, pl->lb);
         lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t2, pl->lb);
+        floor = SPLAT(ROW_BLOCKED_SHARE) * (lm.ma + lm.mb);
     }
-    lane_t normal_mass = ROW_MASS(lin[0]), tangent_mass[2] = {zero, zero};
+    lane_t normal_mass = ROW_MASS_ABOVE(lin[0], floor), tangent_mass[2] = {zero, zero};
     if (friction) {
-        tangent_mass[0] = ROW_MASS(lin[1]);
-        tangent_mass[1] = ROW_MASS(lin[2]);
+        tangent_mass[0] = ROW_MASS_ABOVE(lin[1], floor);
+        tangent_mass[1] = ROW_MASS_ABOVE(lin[2], floor);
     }
     lane_t dv[3];
     for (int d = 0; d < 3; d++) dv[d] = lm.vb[d] - lm.va[d];
@@ -1364,7 +1369,7 @@ LANE_INLINE double prepare_batch_p(const wide_batch *wb, wide_plane *pl, wide_pp
     MAT_VEC(ilb, lm.ib, pl->lb);
     pl->ka = DOT3(pl->la, ila);
     pl->kb = DOT3(pl->lb, ilb);
-    lane_t lin[3];
+    lane_t lin[3], floor = SPLAT(ROW_BLOCKED_SHARE) * (lm.ma + lm.mb);
     lin[0] = LOCKED_INV_MASS(lm.ma, wb->n, pl->la) + LOCKED_INV_MASS(lm.mb, wb->n, pl->lb);
     lin[1] = LOCKED_INV_MASS(lm.ma, wb->t1, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t1, pl->lb);
     lin[2] = LOCKED_INV_MASS(lm.ma, wb->t2, pl->la) + LOCKED_INV_MASS(lm.mb, wb->t2, pl->lb);
@@ -1380,7 +1385,7 @@ LANE_INLINE double prepare_batch_p(const wide_batch *wb, wide_plane *pl, wide_pp
         p->ja_n = DOT3(xa, pl->la);
         p->jb_n = DOT3(xb, pl->lb);
         lane_t kn = lin[0] + pl->ka * p->ja_n * p->ja_n + pl->kb * p->jb_n * p->jb_n;
-        p->normal_mass = ROW_MASS(kn);
+        p->normal_mass = ROW_MASS_ABOVE(kn, floor);
         if (friction) {
             CROSS(xa, ra, wb->t1);
             CROSS(xb, rb, wb->t1);
@@ -1392,8 +1397,8 @@ LANE_INLINE double prepare_batch_p(const wide_batch *wb, wide_plane *pl, wide_pp
             p->jb_t[1] = DOT3(xb, pl->lb);
             lane_t k1 = lin[1] + pl->ka * p->ja_t[0] * p->ja_t[0] + pl->kb * p->jb_t[0] * p->jb_t[0];
             lane_t k2 = lin[2] + pl->ka * p->ja_t[1] * p->ja_t[1] + pl->kb * p->jb_t[1] * p->jb_t[1];
-            p->tangent_mass[0] = ROW_MASS(k1);
-            p->tangent_mass[1] = ROW_MASS(k2);
+            p->tangent_mass[0] = ROW_MASS_ABOVE(k1, floor);
+            p->tangent_mass[1] = ROW_MASS_ABOVE(k2, floor);
         }
         p->base_separation = sep;
         lane_t wxa[3], wxb[3];

@@ -51,29 +51,6 @@
 /* the look-ahead of a near pair's contacts against a mesh or height field */
 #define TOI_NEAR_REACH (4 * TOI_NEAR)
 
-/* Thickness below which a shape can pass through others in one step. */
-static double min_extent(const shape *s)
-{
-    switch (s->type) {
-    case SHAPE_SPHERE: case SHAPE_CAPSULE: return s->radius;
-    case SHAPE_BOX: return dmin(s->half_extents.x, dmin(s->half_extents.y, s->half_extents.z));
-    case SHAPE_CYLINDER: return dmin(s->radius, s->half_height);
-    case SHAPE_HULL: {
-        double m = 1e300;
-        for (int i = 0; i < s->hull->face_count; i++)
-            m = dmin(m, s->hull->faces[i].offset - v3_dot(s->hull->faces[i].normal, s->hull->centroid));
-        return m > 0 ? m : 0.0;
-    }
-    case SHAPE_COMPOUND: {
-        /* the thinnest child can pass through first */
-        double m = 1e300;
-        for (int i = 0; i < s->compound->count; i++) m = dmin(m, min_extent(&s->compound->children[i]));
-        return m;
-    }
-    default: return 1e300;
-    }
-}
-
 /* How fast the shape's surface can approach anything per radian of turn
  * about the unit axis u (body frame) through the centre of mass com: the
  * largest distance from that axis of the points that carry its geometry
@@ -217,7 +194,7 @@ static int far_triangle(void *ctx, const vec3 v[3], unsigned active, uint32_t in
 static double inner_radius(const shape *s)
 {
     switch (s->type) {
-    case SHAPE_SPHERE: case SHAPE_CAPSULE: case SHAPE_BOX: case SHAPE_CYLINDER: return min_extent(s);
+    case SHAPE_SPHERE: case SHAPE_CAPSULE: case SHAPE_BOX: case SHAPE_CYLINDER: return shape_thickness(s);
     default: return 0.0;
     }
 }
@@ -491,7 +468,7 @@ static int may_need_sweep(const carom_world *w, const step_context *step, int sl
         double reach = shape_bounding_radius(sh) + v3_len(lc);
         bound = v3_len(v3_sub(s->center[slot], c0)) + v3_len(step->dq[k]) * reach;
     }
-    if (!(bound <= min_extent(sh))) return 1; /* NaN: let the sweep decide */
+    if (!(bound <= shape_thickness(sh))) return 1; /* NaN: let the sweep decide */
     return bound > TOI_SINK ? 2 : 0;
 }
 
@@ -614,7 +591,7 @@ int world_continuous(carom_world *w, const step_context *step)
         double travel = v3_len(sw->dc) + sw->turn;
         int bullet = (s->flags[i] & BODY_BULLET) != 0;
         if (!(travel > 0) || !isfinite(travel)) continue;
-        if (!bullet && travel <= min_extent(&s->shapes[i])) {
+        if (!bullet && travel <= shape_thickness(&s->shapes[i])) {
             if (!(travel > TOI_SINK) || !end_state(w, step, i, state)) continue;
             sw->at_rest_only = 1;
         }

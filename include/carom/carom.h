@@ -400,7 +400,7 @@ typedef struct carom_body_def {
     int lock_rotation;             /* 0: 1 makes the body a particle (never rotates) */
     int lock_to_plane;             /* 0: 1 keeps the body in the plane through its start
                                       position with normal plane_normal (2D) */
-    carom_vec3 plane_normal;       /* (0, 1, 0): the x-z plane */
+    carom_vec3 plane_normal;       /* (0, 1, 0): the x-z plane; read only with lock_to_plane */
     int bullet;                    /* 0: 1 = swept every step, however slowly it moves (fast bodies always are) */
     int enable_sleep;              /* 1 */
     int awake;                     /* 1 */
