@@ -597,6 +597,31 @@ COLLIDE_INLINE int narrow_contact(carom_world *w, const step_context *ctx, int i
  * whose bounds no longer overlap is removed when may_remove (returns 0:
  * index i now holds another contact), else only emptied. a, b: the
  * bodies' slots, awake_a, awake_b: body_awake of each (the caller's test). */
+/* Whether composite contact i can name its pair in a begin event (it has
+ * points) or an end event (it had them last step). */
+static int speaks_for_pair(const contact_set *cs, int i, int touching)
+{
+    if (touching) return CONTACT_DATA(cs, i)->m.count > 0;
+    return (cs->items[i].flags & CONTACT_WAS_TOUCHING) != 0;
+}
+
+/* A composite pair's contact (sub 0) without a manifold this step or last:
+ * its normal and material are read again only after a manifold is written
+ * into it, so they are made what a snapshot restores (no normal and the
+ * mixed material, or no record at all), and a restored world steps on as
+ * the original. (A stale normal here was written into the next snapshot
+ * once another child pair touched, ANY_TOUCHING, and a restored world's
+ * snapshots then differed from the original's.) */
+static void forget_empty_record(carom_world *w, int i)
+{
+    contact_set *cs = &w->contacts;
+    if (!cs->items[i].slot) return;
+    contact_data *d = CONTACT_DATA(cs, i);
+    d->m.normal = v3(0, 0, 0);
+    if (d->tangent1.x == 0 && d->tangent1.y == 0 && d->tangent1.z == 0) contact_data_release(cs, i);
+    else material_mix_contact(w, i);
+}
+
 COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i, int a, int b, int awake_a, int awake_b,
                                   double reuse, int may_remove, int *woken)
 {
@@ -629,15 +654,17 @@ COLLIDE_INLINE int update_contact(carom_world *w, const step_context *ctx, int i
             if (!awake_b && s->type[b] != CAROM_BODY_STATIC) { wake_for_step(w, b); (*woken)++; }
         }
         if (touching != was) {
-            /* the event speaks of the pair: any manifold with points */
+            /* the event speaks of the pair: a manifold with points (begin),
+             * or one that had them last step (end: its last normal) */
             int ei = i;
-            for (uint32_t k = 1; (CONTACT_DATA(cs, ei))->m.count == 0 && k < c->sub_limit; k++) {
+            for (uint32_t k = 1; !speaks_for_pair(cs, ei, touching) && k < c->sub_limit; k++) {
                 int e = contact_find_sub(cs, c->id_a, c->id_b, k);
-                if (e >= 0 && (CONTACT_DATA(cs, e))->m.count > 0) ei = e;
+                if (e >= 0 && speaks_for_pair(cs, e, touching)) ei = e;
             }
             events_touch(w, ei, touching ? CAROM_EVENT_BEGIN : CAROM_EVENT_END);
         }
         if (d->m.count > 0) list_touching(sc, s, i, a, b);
+        else if (!(c->flags & CONTACT_WAS_TOUCHING)) forget_empty_record(w, i);
         return 1;
     }
     if (bounds_overlap) {

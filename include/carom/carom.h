@@ -616,9 +616,10 @@ CAROM_API carom_status carom_world_get_event_children(const carom_world *world, 
  * into buf in carom's versioned little-endian format (docs/snapshot.md) and
  * returns its size in bytes. When that is more than capacity nothing usable
  * is written: call with capacity 0 (buf may be NULL) to learn the size.
- * Returns 0 for a NULL world, inside the world's step, or for a world with a
- * mesh, height field or compound (not in the format yet). The event callback,
- * its context and bodies' user data are pointers and are not written. */
+ * Every shape is written, meshes, height fields and compounds whole.
+ * Returns 0 for a NULL world, inside the world's step, or out of memory.
+ * The event callback, its context and bodies' user data are pointers and
+ * are not written. */
 CAROM_API size_t carom_world_snapshot(const carom_world *world, void *buf, size_t capacity);
 /* A new world from a snapshot; it continues bit for bit as the original
  * would have. NULL when the data is not a snapshot of this version, is
