@@ -100,26 +100,30 @@ static int ray_cast_part(const shape *s, vec3 o, vec3 d, double max_t, double *t
     }
 }
 
-/* 1 when the body-frame point is inside a compound's child. */
-static int compound_contains(const compound *c, vec3 p)
+/* The lowest-index child of a compound that holds the body-frame point, or -1. */
+static int compound_child_containing(const compound *c, vec3 p)
 {
     for (int i = 0; i < c->count; i++)
-        if (shape_contains_local(&c->children[i], xf_inv_point(c->poses[i], p))) return 1;
-    return 0;
+        if (shape_contains_local(&c->children[i], xf_inv_point(c->poses[i], p))) return i;
+    return -1;
 }
 
 /* Ray origin + t dir, t in [0, max_t], against the body at slot (world
- * frame). Starts inside: t = 0, normal against the ray. */
-static int ray_body(const body_store *s, int slot, vec3 origin, vec3 dir, double max_t, double *t, vec3 *normal,
-                    int *part)
+ * frame). Starts inside: t = 0, normal against the ray, and *part the
+ * compound child holding the origin when name_inside (else -1: what
+ * carom_world_ray_cast_child has always answered). */
+static int ray_body(const body_store *s, int slot, vec3 origin, vec3 dir, double max_t, int name_inside, double *t,
+                    vec3 *normal, int *part)
 {
     const shape *sh = &s->shapes[slot];
     *part = -1;
     xform x = body_xform(s, slot);
     vec3 o = xf_inv_point(x, origin), d = q_inv_rotate(x.q, dir);
-    if (sh->type == SHAPE_COMPOUND ? compound_contains(sh->compound, o) : shape_contains_local(sh, o)) {
+    int inside_child = sh->type == SHAPE_COMPOUND ? compound_child_containing(sh->compound, o) : -1;
+    if (sh->type == SHAPE_COMPOUND ? inside_child >= 0 : shape_contains_local(sh, o)) {
         *t = 0.0;
         *normal = v3_neg(v3_normalize(dir));
+        if (name_inside) *part = inside_child;
         return 1;
     }
     double t0 = 0.0;
@@ -187,18 +191,18 @@ typedef struct triangle_query {
     int cast;                 /* 1: sweep, else: distance */
     int found;
     gjk_cast_result hit;
+    uint32_t hit_index;       /* the triangle of hit */
     gjk_result nearest;
 } triangle_query;
 
 static int visit_triangle(void *ctx, const vec3 v[3], unsigned active_edges, uint32_t index)
 {
     (void)active_edges;
-    (void)index;
     triangle_query *q = ctx;
     gjk_proxy tri = {NULL, v, 3, q->b->x};
     if (q->cast) {
         gjk_cast_result r = gjk_shape_cast(q->a, q->translation, &tri);
-        if (r.hit && (!q->found || r.fraction < q->hit.fraction)) { q->hit = r; q->found = 1; }
+        if (r.hit && (!q->found || r.fraction < q->hit.fraction)) { q->hit = r; q->hit_index = index; q->found = 1; }
         return !(q->found && q->hit.fraction == 0.0);
     }
     gjk_result r = gjk_distance(q->a, &tri);
@@ -229,15 +233,18 @@ static gjk_proxy compound_child(const gjk_proxy *p, int i)
     return child;
 }
 
-/* Sweep of convex A along translation against B (any shape). */
-static gjk_cast_result cast_body(const gjk_proxy *a, vec3 translation, const gjk_proxy *b)
+/* Sweep of convex A along translation against B (any shape); *part: the
+ * compound child or triangle hit (-1: B is one part, or no hit). */
+static gjk_cast_result cast_body(const gjk_proxy *a, vec3 translation, const gjk_proxy *b, int *part)
 {
+    *part = -1;
     if (b->s->type == SHAPE_COMPOUND) { /* the first child hit */
         gjk_cast_result best = {0, 0, v3_zero(), v3_zero()};
         for (int i = 0; i < b->s->compound->count; i++) {
             gjk_proxy child = compound_child(b, i);
-            gjk_cast_result r = cast_body(a, translation, &child);
-            if (r.hit && (!best.hit || r.fraction < best.fraction)) best = r;
+            int unused;
+            gjk_cast_result r = cast_body(a, translation, &child, &unused);
+            if (r.hit && (!best.hit || r.fraction < best.fraction)) { best = r; *part = i; }
         }
         return best;
     }
@@ -250,6 +257,7 @@ static gjk_cast_result cast_body(const gjk_proxy *a, vec3 translation, const gjk
         q.cast = 1;
         aabb start = proxy_aabb(a), end = {v3_add(start.lo, translation), v3_add(start.hi, translation)};
         query_triangles(&q, aabb_union(start, end));
+        if (q.found) *part = (int)q.hit_index;
         return q.hit;
     }
     if (b->s->type != SHAPE_PLANE) return gjk_shape_cast(a, translation, b);
@@ -348,6 +356,45 @@ static gjk_result pair_distance(const gjk_proxy *a, const gjk_proxy *b, double r
     return r;
 }
 
+/* ---- which part of a body a query shape overlaps -------------------------------- */
+
+typedef struct lowest_overlap {
+    const gjk_proxy *a;       /* the convex query shape */
+    xform x;                  /* the mesh's frame */
+    int part;                 /* the lowest overlapping triangle so far, -1: none */
+} lowest_overlap;
+
+static int visit_overlapping_triangle(void *ctx, const vec3 v[3], unsigned active_edges, uint32_t index)
+{
+    (void)active_edges;
+    lowest_overlap *o = ctx;
+    if (o->part >= 0 && index >= (uint32_t)o->part) return 1; /* a lower one overlaps already */
+    gjk_proxy tri = {NULL, v, 3, o->x};
+    if (gjk_distance(o->a, &tri).overlap) o->part = (int)index;
+    return 1; /* every triangle: the tree's order is not the index order */
+}
+
+/* The lowest-index part of B (compound child, mesh triangle, height-field
+ * cell*2 + half) that convex A overlaps, by the test carom_world_overlap
+ * applies to the part: so a body it reports always names one. -1 for a
+ * one-part B. */
+static int overlap_part(const gjk_proxy *a, const gjk_proxy *b)
+{
+    if (b->s->type == SHAPE_COMPOUND) {
+        for (int i = 0; i < b->s->compound->count; i++) {
+            gjk_proxy child = compound_child(b, i);
+            if (gjk_distance(a, &child).overlap) return i;
+        }
+        return -1;
+    }
+    if (!is_triangles(b->s)) return -1;
+    lowest_overlap o = {a, b->x, -1};
+    aabb local = box_in_frame(proxy_aabb(a), b->x);
+    if (b->s->type == SHAPE_MESH) mesh_query(b->s->mesh, local, visit_overlapping_triangle, &o);
+    else heightfield_query(b->s->field, local, visit_overlapping_triangle, &o);
+    return o.part;
+}
+
 int query_shapes_overlap(const shape *a, xform xa, const shape *b, xform xb)
 {
     if (a->type == SHAPE_PLANE || is_triangles(a)) { /* the convex one (or a compound) first */
@@ -425,13 +472,19 @@ static int find_candidates(const carom_world *w, aabb box, candidate_list *l)
 
 /* ---- rays --------------------------------------------------------------------- */
 
+/* A hit and the part of the body it is on (-1: the body is one part). */
+typedef struct part_hit {
+    carom_ray_hit hit;
+    int part;
+} part_hit;
+
 typedef struct ray_hits {
     query_context q;
-    carom_ray_hit *items;
+    part_hit *items;
     int count, capacity;
     int all, failed;
-    carom_ray_hit best;
-    int best_part;
+    int name_inside;          /* a ray starting inside a compound names the child holding its origin */
+    part_hit best;
 } ray_hits;
 
 static double ray_visit(void *ctx, int id_index, vec3 origin, vec3 dir, double max_t)
@@ -442,16 +495,17 @@ static double ray_visit(void *ctx, int id_index, vec3 origin, vec3 dir, double m
     double t;
     vec3 n;
     int part;
-    if (slot < 0 || !ray_body(s, slot, origin, dir, h->all ? 1.0 : max_t, &t, &n, &part)) return max_t;
+    if (slot < 0 || !ray_body(s, slot, origin, dir, h->all ? 1.0 : max_t, h->name_inside, &t, &n, &part))
+        return max_t;
     if (!body_visible(&h->q, id_index)) return max_t;
-    carom_ray_hit hit;
-    hit.body = world_make_id(h->q.w, id_index);
-    hit.point = from_v3(v3_madd(origin, t, dir));
-    hit.normal = from_v3(n);
-    hit.fraction = t;
+    part_hit hit;
+    hit.hit.body = world_make_id(h->q.w, id_index);
+    hit.hit.point = from_v3(v3_madd(origin, t, dir));
+    hit.hit.normal = from_v3(n);
+    hit.hit.fraction = t;
+    hit.part = part;
     if (!h->all) {
         h->best = hit;
-        h->best_part = part;
         h->count = 1;
         return t; /* clip: only closer hits from now on */
     }
@@ -470,23 +524,36 @@ static int check_ray(const carom_world *w, const char *fn, carom_vec3 origin, ca
     return 1;
 }
 
-CAROM_API int carom_world_ray_cast_filtered(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
-                                            const carom_query_filter *filter, carom_ray_hit *hit)
+/* The closest hit and its part (child may be NULL): the public closest-hit
+ * casts, their checks and messages under fn. */
+static int ray_cast_closest(const carom_world *w, const char *fn, carom_vec3 origin, carom_vec3 translation,
+                            const carom_query_filter *filter, int name_inside, carom_ray_hit *hit, int *child)
 {
+    if (child) *child = -1;
     if (!w) return -1;
-    if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast: hit is NULL"), -1;
-    if (!check_ray(w, "ray_cast", origin, translation)) return -1;
+    if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: hit is NULL", fn), -1;
+    if (!check_ray(w, fn, origin, translation)) return -1;
     memset(hit, 0, sizeof *hit);
     if (v3_len2(to_v3(translation)) == 0) return 0;
     ray_hits h;
     memset(&h, 0, sizeof h);
     h.q.w = w;
     h.q.filter = filter;
+    h.name_inside = name_inside;
     int was = query_lock(w);
     bp_ray_cast(w->bp, to_v3(origin), to_v3(translation), 1.0, ray_visit, &h);
     query_unlock(w, was);
-    if (h.count) *hit = h.best;
+    if (h.count) {
+        *hit = h.best.hit;
+        if (child) *child = h.best.part;
+    }
     return h.count;
+}
+
+CAROM_API int carom_world_ray_cast_filtered(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
+                                            const carom_query_filter *filter, carom_ray_hit *hit)
+{
+    return ray_cast_closest(w, "ray_cast", origin, translation, filter, 0, hit, NULL);
 }
 
 CAROM_API int carom_world_ray_cast(const carom_world *w, carom_vec3 origin, carom_vec3 translation, carom_ray_hit *hit)
@@ -497,63 +564,69 @@ CAROM_API int carom_world_ray_cast(const carom_world *w, carom_vec3 origin, caro
 CAROM_API int carom_world_ray_cast_child(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
                                          carom_ray_hit *hit, int *child)
 {
-    if (child) *child = -1;
-    if (!w) return -1;
-    if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast_child: hit is NULL"), -1;
-    if (!check_ray(w, "ray_cast_child", origin, translation)) return -1;
-    memset(hit, 0, sizeof *hit);
-    if (v3_len2(to_v3(translation)) == 0) return 0;
-    ray_hits h;
-    memset(&h, 0, sizeof h);
-    h.q.w = w;
-    bp_ray_cast(w->bp, to_v3(origin), to_v3(translation), 1.0, ray_visit, &h);
-    if (h.count) {
-        *hit = h.best;
-        if (child) *child = h.best_part;
-    }
-    return h.count;
+    return ray_cast_closest(w, "ray_cast_child", origin, translation, NULL, 0, hit, child);
 }
 
 static int compare_hits(const void *pa, const void *pb)
 {
-    const carom_ray_hit *a = pa, *b = pb;
+    const carom_ray_hit *a = &((const part_hit *)pa)->hit, *b = &((const part_hit *)pb)->hit;
     if (a->fraction != b->fraction) return a->fraction < b->fraction ? -1 : 1;
     return (a->body.index1 > b->body.index1) - (a->body.index1 < b->body.index1);
 }
 
-CAROM_API int carom_world_ray_cast_all(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
-                                       const carom_query_filter *filter, carom_ray_hit *hits, int capacity)
+/* Every hit, nearest first, and the part of each (children may be NULL). */
+static int ray_cast_every(const carom_world *w, const char *fn, carom_vec3 origin, carom_vec3 translation,
+                          const carom_query_filter *filter, int name_inside, carom_ray_hit *hits, int *children,
+                          int capacity)
 {
     if (!w) return -1;
     if (capacity < 0 || (capacity > 0 && !hits))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "ray_cast_all: bad output array"), -1;
-    if (!check_ray(w, "ray_cast_all", origin, translation)) return -1;
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: bad output array", fn), -1;
+    if (!check_ray(w, fn, origin, translation)) return -1;
     if (v3_len2(to_v3(translation)) == 0) return 0;
     ray_hits h;
     memset(&h, 0, sizeof h);
     h.q.w = w;
     h.q.filter = filter;
     h.all = 1;
+    h.name_inside = name_inside;
     int was = query_lock(w);
     bp_ray_cast(w->bp, to_v3(origin), to_v3(translation), 1.0, ray_visit, &h);
     query_unlock(w, was);
     if (h.failed) {
         free(h.items);
-        return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "ray_cast_all: out of memory"), -1;
+        return world_fail(w, CAROM_ERROR_OUT_OF_MEMORY, "%s: out of memory", fn), -1;
     }
     if (h.count > 1) qsort(h.items, (size_t)h.count, sizeof *h.items, compare_hits);
-    for (int i = 0; i < h.count && i < capacity; i++) hits[i] = h.items[i];
+    for (int i = 0; i < h.count && i < capacity; i++) {
+        hits[i] = h.items[i].hit;
+        if (children) children[i] = h.items[i].part;
+    }
     free(h.items);
     return h.count;
 }
 
+CAROM_API int carom_world_ray_cast_all(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
+                                       const carom_query_filter *filter, carom_ray_hit *hits, int capacity)
+{
+    return ray_cast_every(w, "ray_cast_all", origin, translation, filter, 0, hits, NULL, capacity);
+}
+
+CAROM_API int carom_world_ray_cast_all_children(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
+                                                const carom_query_filter *filter, carom_ray_hit *hits, int *children,
+                                                int capacity)
+{
+    return ray_cast_every(w, "ray_cast_all_children", origin, translation, filter, 1, hits, children, capacity);
+}
+
 /* ---- shape casts, overlaps, distances ----------------------------------------- */
 
-CAROM_API int carom_world_shape_cast(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
-                                     carom_quat orientation, carom_vec3 translation,
-                                     const carom_query_filter *filter, carom_ray_hit *hit)
+/* The first body the sweep touches, and the part of it (child may be NULL). */
+static int shape_cast_first(const carom_world *w, const char *fn, const carom_shape_def *def, carom_vec3 position,
+                            carom_quat orientation, carom_vec3 translation, const carom_query_filter *filter,
+                            carom_ray_hit *hit, int *child)
 {
-    const char *fn = "shape_cast";
+    if (child) *child = -1;
     if (!w) return -1;
     if (!hit) return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: hit is NULL", fn), -1;
     if (!v3_is_finite(to_v3(translation)))
@@ -578,13 +651,15 @@ CAROM_API int carom_world_shape_cast(const carom_world *w, const carom_shape_def
     for (int i = 0; i < l.count; i++) {
         int slot = w->bodies.ids[l.items[i]].slot;
         gjk_proxy b = body_proxy(&w->bodies, slot, pose.p);
-        gjk_cast_result r = cast_body(&a, T, &b);
+        int part;
+        gjk_cast_result r = cast_body(&a, T, &b, &part);
         if (!r.hit || (found && r.fraction >= hit->fraction) || !body_visible(&q, l.items[i])) continue;
         found = 1;
         hit->body = world_make_id(w, l.items[i]);
         hit->fraction = r.fraction;
         hit->point = from_v3(v3_add(r.point, pose.p));
         hit->normal = from_v3(r.normal);
+        if (child) *child = part;
     }
     query_unlock(w, was);
     free(l.items);
@@ -592,11 +667,26 @@ CAROM_API int carom_world_shape_cast(const carom_world *w, const carom_shape_def
     return found;
 }
 
-CAROM_API int carom_world_overlap(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
-                                  carom_quat orientation, const carom_query_filter *filter, carom_body_id *ids,
-                                  int capacity)
+CAROM_API int carom_world_shape_cast(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
+                                     carom_quat orientation, carom_vec3 translation,
+                                     const carom_query_filter *filter, carom_ray_hit *hit)
 {
-    const char *fn = "overlap";
+    return shape_cast_first(w, "shape_cast", def, position, orientation, translation, filter, hit, NULL);
+}
+
+CAROM_API int carom_world_shape_cast_child(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
+                                           carom_quat orientation, carom_vec3 translation,
+                                           const carom_query_filter *filter, carom_ray_hit *hit, int *child)
+{
+    return shape_cast_first(w, "shape_cast_child", def, position, orientation, translation, filter, hit, child);
+}
+
+/* The overlapping bodies, and (children not NULL) the lowest part of each
+ * the shape overlaps. */
+static int overlap_bodies(const carom_world *w, const char *fn, const carom_shape_def *def, carom_vec3 position,
+                          carom_quat orientation, const carom_query_filter *filter, carom_body_id *ids, int *children,
+                          int capacity)
+{
     if (!w) return -1;
     if (capacity < 0 || (capacity > 0 && !ids))
         return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: bad output array", fn), -1;
@@ -617,13 +707,30 @@ CAROM_API int carom_world_overlap(const carom_world *w, const carom_shape_def *d
         gjk_proxy b = body_proxy(&w->bodies, slot, pose.p);
         gjk_result r = is_convex(b.s) ? gjk_distance(&a, &b) : pair_distance(&a, &b, 0.0);
         if (!r.overlap || !body_visible(&q, l.items[i])) continue;
-        if (count < capacity) ids[count] = world_make_id(w, l.items[i]);
+        if (count < capacity) {
+            ids[count] = world_make_id(w, l.items[i]);
+            if (children) children[count] = overlap_part(&a, &b);
+        }
         count++;
     }
     query_unlock(w, was);
     free(l.items);
     hull_free(sh.hull);
     return count;
+}
+
+CAROM_API int carom_world_overlap(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
+                                  carom_quat orientation, const carom_query_filter *filter, carom_body_id *ids,
+                                  int capacity)
+{
+    return overlap_bodies(w, "overlap", def, position, orientation, filter, ids, NULL, capacity);
+}
+
+CAROM_API int carom_world_overlap_children(const carom_world *w, const carom_shape_def *def, carom_vec3 position,
+                                           carom_quat orientation, const carom_query_filter *filter,
+                                           carom_body_id *ids, int *children, int capacity)
+{
+    return overlap_bodies(w, "overlap_children", def, position, orientation, filter, ids, children, capacity);
 }
 
 static void fill_distance(carom_distance_result *out, const gjk_result *r, vec3 ref)

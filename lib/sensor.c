@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "array.h"
+#include "compound.h"
 #include "events.h"
 #include "filter.h"
 #include "query.h"
@@ -165,18 +166,34 @@ int world_update_sensors(carom_world *w, const step_context *ctx)
 
 /* ---- reading contacts ------------------------------------------------------------- */
 
+/* The id index of a body whose contacts are asked for with an output of
+ * capacity entries (has_output: the array is not NULL), or -1 (the error set). */
+static int contacts_of(const carom_world *w, carom_body_id id, const char *fn, int capacity, int has_output)
+{
+    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
+    if (slot < 0) return world_fail(w, CAROM_ERROR_STALE_ID, "%s: body has been destroyed (or the id is invalid)", fn), -1;
+    if (capacity < 0 || (capacity > 0 && !has_output))
+        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "%s: bad output array", fn), -1;
+    return (int)id.index1 - 1;
+}
+
+/* Whether contact c is one of body me's touching ones (the order both
+ * carom_body_get_contacts and carom_body_get_contact_children list). */
+static int touching_contact_of(const contact *c, int me)
+{
+    return (c->id_a == me || c->id_b == me) && (c->flags & CONTACT_TOUCHING);
+}
+
 CAROM_API int carom_body_get_contacts(const carom_world *w, carom_body_id id, carom_contact_info *out, int capacity)
 {
     if (!w) return -1;
-    int slot = body_store_slot(&w->bodies, id.index1, id.generation);
-    if (slot < 0) return world_fail(w, CAROM_ERROR_STALE_ID, "body_get_contacts: body has been destroyed (or the id is invalid)"), -1;
-    if (capacity < 0 || (capacity > 0 && !out))
-        return world_fail(w, CAROM_ERROR_INVALID_ARGUMENT, "body_get_contacts: bad output array"), -1;
+    int me = contacts_of(w, id, "body_get_contacts", capacity, out != NULL);
+    if (me < 0) return -1;
     const contact_set *cs = &w->contacts;
-    int me = (int)id.index1 - 1, count = 0;
+    int count = 0;
     for (int i = 0; i < cs->count; i++) {
         const contact *c = &cs->items[i];
-        if ((c->id_a != me && c->id_b != me) || !(c->flags & CONTACT_TOUCHING)) continue;
+        if (!touching_contact_of(c, me)) continue;
         const contact_data *d = CONTACT_DATA(cs, i);
         if (count < capacity) {
             carom_contact_info *ci = &out[count];
@@ -195,6 +212,32 @@ CAROM_API int carom_body_get_contacts(const carom_world *w, carom_body_id id, ca
             /* the state keeps the sub-step impulse (warm start): times the
              * sub-steps is the step's */
             ci->normal_impulse = impulse * w->def.substeps;
+        }
+        count++;
+    }
+    return count;
+}
+
+CAROM_API int carom_body_get_contact_children(const carom_world *w, carom_body_id id, int *children_self,
+                                              int *children_other, int capacity)
+{
+    if (!w) return -1;
+    int me = contacts_of(w, id, "body_get_contact_children", capacity, children_self || children_other);
+    if (me < 0) return -1;
+    const contact_set *cs = &w->contacts;
+    const body_store *s = &w->bodies;
+    int count = 0;
+    for (int i = 0; i < cs->count; i++) {
+        const contact *c = &cs->items[i];
+        if (!touching_contact_of(c, me)) continue;
+        if (count < capacity) {
+            /* the contact's sub names the child pair, as for its events */
+            int ca = -1, cb = -1;
+            int sa = s->ids[c->id_a].slot, sb = s->ids[c->id_b].slot;
+            if (sa >= 0 && sb >= 0) compound_sub_children(&s->shapes[sa], &s->shapes[sb], c->sub, &ca, &cb);
+            int flip = c->id_b == me;
+            if (children_self) children_self[count] = flip ? cb : ca;
+            if (children_other) children_other[count] = flip ? ca : cb;
         }
         count++;
     }

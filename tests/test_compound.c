@@ -1,7 +1,8 @@
 /* test_compound.c - compound bodies: mass properties against closed forms,
  * a dumbbell rolling down an incline as the analytic rigid body does, a table
- * of five boxes standing on a mesh floor, the child named in ray casts and
- * events, and bad compounds refused with the world unchanged. */
+ * of five boxes standing on a mesh floor, the child named in ray casts (closest
+ * and all), shape casts, overlaps, events and a body's contacts, and bad
+ * compounds refused with the world unchanged. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -278,6 +279,249 @@ static void test_child_in_ray_casts_and_events(void **state)
     carom_world_destroy(w);
 }
 
+/* Three spheres of radius 0.25 at x = -1, 0, +1 (children 0, 1, 2) of a
+ * static compound at `at`. */
+static carom_body_id add_three_spheres(carom_world *w, carom_vec3 at)
+{
+    carom_compound_child c[3];
+    for (int i = 0; i < 3; i++) {
+        c[i] = carom_compound_child_default(carom_shape_sphere(0.25));
+        c[i].position.x = i - 1.0;
+    }
+    return add_compound(w, c, 3, CAROM_BODY_STATIC, at);
+}
+
+/* ray_cast_all_children: a ray along +y at x = 1 passes child 2 of A (at
+ * the origin), child 0 of B (at x = 2, y = 5) and a plain sphere (y = 8):
+ * each hit names its own child, in the order and with the hits of
+ * carom_world_ray_cast_all. A ray from inside a child names that child. */
+static void test_ray_cast_all_names_children(void **state)
+{
+    (void)state;
+    carom_world *w = world_no_gravity();
+    carom_body_id a = add_three_spheres(w, vec(0, 0, 0)), b = add_three_spheres(w, vec(2, 5, 0));
+    carom_body_id plain = add_static(w, carom_shape_sphere(0.25), vec(1, 8, 0));
+    carom_vec3 from = {1, -3, 0}, along = {0, 12, 0};
+    carom_ray_hit hits[3], plain_hits[3];
+    int children[3] = {-7, -7, -7};
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, hits, children, 3), 3);
+    assert_int_equal(carom_world_ray_cast_all(w, from, along, NULL, plain_hits, 3), 3);
+    const carom_body_id want_body[3] = {a, b, plain};
+    const int want_child[3] = {2, 0, -1};
+    const double want_y[3] = {-0.25, 4.75, 7.75};
+    for (int i = 0; i < 3; i++) {
+        assert_true(carom_body_id_equal(hits[i].body, want_body[i]));
+        assert_int_equal(children[i], want_child[i]);
+        assert_true(fabs(hits[i].point.y - want_y[i]) < 1e-12);
+        assert_true(fabs(hits[i].fraction - (want_y[i] + 3) / 12) < 1e-12);
+        assert_memory_equal(&hits[i], &plain_hits[i], sizeof hits[i]);
+    }
+    /* children may be NULL; a short array gets the nearest hits */
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, hits, NULL, 3), 3);
+    children[1] = -7;
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, hits, children, 1), 3);
+    assert_int_equal(children[0], 2);
+    assert_int_equal(children[1], -7);
+    /* a filter leaves A out: B's child 0 comes first */
+    carom_body_set_filter(w, a, 2, CAROM_MASK_ALL, 0);
+    carom_query_filter f = carom_query_filter_default();
+    f.mask = 1;
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, &f, hits, children, 3), 2);
+    assert_int_equal(children[0], 0);
+    assert_int_equal(children[1], -1);
+    /* starting inside A's child 0: fraction 0 on child 0 (ray_cast_child
+     * has always named no child there) */
+    carom_vec3 inside = {-1, 0.1, 0}, up = {0, 0, 2};
+    assert_int_equal(carom_world_ray_cast_all_children(w, inside, up, NULL, hits, children, 3), 1);
+    assert_true(carom_body_id_equal(hits[0].body, a) && hits[0].fraction == 0.0);
+    assert_int_equal(children[0], 0);
+    int child = -7;
+    assert_int_equal(carom_world_ray_cast_child(w, inside, up, hits, &child), 1);
+    assert_int_equal(child, -1);
+    /* bad input as ray_cast_all */
+    assert_int_equal(carom_world_ray_cast_all_children(NULL, from, along, NULL, hits, children, 3), -1);
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, hits, children, -1), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "ray_cast_all_children: bad output array"));
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, NULL, children, 3), -1);
+    carom_vec3 bad = {NAN, 0, 0};
+    assert_int_equal(carom_world_ray_cast_all_children(w, bad, along, NULL, hits, children, 3), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "origin and translation must be finite"));
+    carom_world_destroy(w);
+}
+
+/* shape_cast_child: a sphere of radius 0.25 swept along +x at the spheres'
+ * height first touches child 0 (centres 0.5 apart at x = -1.5: fraction
+ * 1.5 / 6), swept along -x child 2; swept down at x = 0.6 it passes child 1
+ * (0.6 > 0.5 off its centre) and lands on child 2 (0.4 off: the centres
+ * 0.5 apart at 0.3 above it, fraction 2.7 / 6). */
+static void test_shape_cast_names_child(void **state)
+{
+    (void)state;
+    carom_world *w = world_no_gravity();
+    carom_body_id a = add_three_spheres(w, vec(0, 0, 0));
+    carom_shape_def ball = carom_shape_sphere(0.25);
+    carom_quat q = {1, 0, 0, 0};
+    carom_ray_hit hit, plain_hit;
+    int child = -7;
+    const struct { carom_vec3 from, along; int child; double fraction; } casts[3] = {
+        {{-3, 0, 0}, {6, 0, 0}, 0, 1.5 / 6}, {{3, 0, 0}, {-6, 0, 0}, 2, 1.5 / 6}, {{0.6, 0, 3}, {0, 0, -6}, 2, 2.7 / 6}};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(carom_world_shape_cast_child(w, &ball, casts[k].from, q, casts[k].along, NULL, &hit, &child), 1);
+        assert_true(carom_body_id_equal(hit.body, a));
+        assert_int_equal(child, casts[k].child);
+        check_abs(hit.fraction, casts[k].fraction, 1e-9, "shape cast fraction");
+        assert_int_equal(carom_world_shape_cast(w, &ball, casts[k].from, q, casts[k].along, NULL, &plain_hit), 1);
+        assert_memory_equal(&hit, &plain_hit, sizeof hit);
+    }
+    /* started overlapping child 1 only: fraction 0 on child 1 */
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(0.1, 0, 0.3), q, vec(0, 0, 1), NULL, &hit, &child), 1);
+    assert_int_equal(child, 1);
+    assert_true(hit.fraction == 0.0);
+    /* a miss and a plain body: -1; child may be NULL */
+    add_static(w, carom_shape_box(0.5, 0.5, 0.5), vec(0, 5, 0));
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(0, 5, 3), q, vec(0, 0, -6), NULL, &hit, &child), 1);
+    assert_int_equal(child, -1);
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(0, 5, 3), q, vec(0, 0, -6), NULL, &hit, NULL), 1);
+    child = -7;
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(0, -5, 3), q, vec(0, 0, -6), NULL, &hit, &child), 0);
+    assert_int_equal(child, -1);
+    /* bad input as shape_cast */
+    assert_int_equal(carom_world_shape_cast_child(NULL, &ball, vec(0, 0, 3), q, vec(0, 0, -6), NULL, &hit, &child), -1);
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(0, 0, 3), q, vec(0, 0, -6), NULL, NULL, &child), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "shape_cast_child: hit is NULL"));
+    carom_shape_def plane = carom_shape_plane(0, 0, 1, 0);
+    assert_int_equal(carom_world_shape_cast_child(w, &plane, vec(0, 0, 3), q, vec(0, 0, -6), NULL, &hit, &child), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "shape must be convex"));
+    carom_world_destroy(w);
+}
+
+/* overlap_children: one entry per body, as carom_world_overlap; a box
+ * covering only child 2 (x in [0.7, 1.3]) names 2, only child 0 names 0,
+ * one over children 1 and 2 (x in [0.2, 0.8]) names the lower, 1. */
+static void test_overlap_names_lowest_child(void **state)
+{
+    (void)state;
+    carom_world *w = world_no_gravity();
+    carom_body_id a = add_three_spheres(w, vec(0, 0, 0)), b = add_three_spheres(w, vec(0, 3, 0));
+    carom_body_id plain = add_static(w, carom_shape_sphere(0.25), vec(0.5, -1, 0));
+    carom_shape_def box = carom_shape_box(0.3, 0.3, 0.3);
+    carom_quat q = {1, 0, 0, 0};
+    carom_body_id ids[4], plain_ids[4];
+    int children[4];
+    const struct { double x; int child; } cases[3] = {{1, 2}, {-1, 0}, {0.5, 1}};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(carom_world_overlap_children(w, &box, vec(cases[k].x, 0, 0), q, NULL, ids, children, 4), 1);
+        assert_true(carom_body_id_equal(ids[0], a));
+        assert_int_equal(children[0], cases[k].child);
+    }
+    /* tall box over A, B and the plain sphere: three entries, in
+     * carom_world_overlap's order */
+    carom_shape_def tall = carom_shape_box(0.3, 3.5, 0.3);
+    int n = carom_world_overlap_children(w, &tall, vec(0.5, 0, 0), q, NULL, ids, children, 4);
+    assert_int_equal(n, 3);
+    assert_int_equal(carom_world_overlap(w, &tall, vec(0.5, 0, 0), q, NULL, plain_ids, 4), 3);
+    for (int i = 0; i < 3; i++) {
+        assert_true(carom_body_id_equal(ids[i], plain_ids[i]));
+        int want = carom_body_id_equal(ids[i], plain) ? -1 : 1;
+        assert_true(carom_body_id_equal(ids[i], a) || carom_body_id_equal(ids[i], b) || want == -1);
+        assert_int_equal(children[i], want);
+    }
+    /* children may be NULL; none overlapping: 0 */
+    assert_int_equal(carom_world_overlap_children(w, &tall, vec(0.5, 0, 0), q, NULL, ids, NULL, 4), 3);
+    assert_int_equal(carom_world_overlap_children(w, &box, vec(0, 0, 5), q, NULL, ids, children, 4), 0);
+    /* bad input as overlap */
+    assert_int_equal(carom_world_overlap_children(NULL, &box, vec(0, 0, 0), q, NULL, ids, children, 4), -1);
+    assert_int_equal(carom_world_overlap_children(w, &box, vec(0, 0, 0), q, NULL, NULL, children, 4), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "overlap_children: bad output array"));
+    assert_int_equal(carom_world_overlap_children(w, &box, vec(0, 0, 0), q, NULL, ids, children, -1), -1);
+    carom_quat bad = {2, 0, 0, 0};
+    assert_int_equal(carom_world_overlap_children(w, &box, vec(0, 0, 0), bad, NULL, ids, children, 4), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "orientation must be a finite unit quaternion"));
+    carom_world_destroy(w);
+}
+
+/* carom_body_get_contact_children: a compound (child 0 a ball on top,
+ * child 1 a slab under it, child 2 a ball off the slab's edge, clear of
+ * the floor)
+ * resting on a flat mesh touches it with child 1 only; a static compound
+ * (child 0 a ball off to the side, child 1 a plate) laid on child 0's top
+ * touches it with its child 1. Each contact's children follow the order
+ * and count of carom_body_get_contacts, from either body's side. */
+static void test_contact_children(void **state)
+{
+    (void)state;
+    carom_world *w = world_default();
+    double *v;
+    int nv, *t, nt;
+    scene_grid(4, 1.0, 0.0, 0, &v, &nv, &t, &nt);
+    carom_quat q = {1, 0, 0, 0};
+    carom_body_id floor = scene_add_mesh(w, v, nv, t, nt, vec(0, 0, 0), q);
+    free(v);
+    free(t);
+    carom_compound_child c[3];
+    c[0] = carom_compound_child_default(carom_shape_sphere(0.2));
+    c[0].position.z = 0.3;
+    c[1] = carom_compound_child_default(carom_shape_box(0.5, 0.5, 0.1));
+    c[2] = carom_compound_child_default(carom_shape_sphere(0.1));
+    c[2].position.x = 0.7;
+    c[2].position.z = 0.25;
+    carom_body_id a = add_compound(w, c, 3, CAROM_BODY_DYNAMIC, vec(0.1, 0.2, 0.1));
+    assert_false(carom_body_id_is_null(floor) || carom_body_id_is_null(a));
+    step_n(w, 60, DT);
+    int self[8], other[8];
+    carom_contact_info info[8];
+    int n = carom_body_get_contacts(w, a, info, 8);
+    assert_true(n >= 1 && n <= 8);
+    assert_int_equal(carom_body_get_contact_children(w, a, self, other, 8), n);
+    for (int i = 0; i < n; i++) {
+        assert_true(carom_body_id_equal(info[i].other, floor));
+        assert_int_equal(self[i], 1);
+        assert_int_equal(other[i], -1);
+    }
+    /* the plate's underside on the top ball (its top at 0.1 + 0.3 + 0.2 up, less what it sank) */
+    carom_vec3 at = pos(w, a);
+    c[0] = carom_compound_child_default(carom_shape_sphere(0.1));
+    c[0].position.x = 3;
+    c[1] = carom_compound_child_default(carom_shape_box(0.3, 0.3, 0.05));
+    carom_body_id lid = add_compound(w, c, 2, CAROM_BODY_STATIC, vec(at.x, at.y, at.z + 0.5 + 0.05 - 1e-3));
+    carom_body_set_awake(w, a, 1); /* it may sleep: a static body wakes nothing */
+    step_n(w, 10, DT);
+    n = carom_body_get_contacts(w, a, info, 8);
+    assert_int_equal(carom_body_get_contact_children(w, a, self, other, 8), n);
+    int with_lid = 0, with_floor = 0;
+    for (int i = 0; i < n; i++) {
+        int on_lid = carom_body_id_equal(info[i].other, lid);
+        with_lid += on_lid;
+        with_floor += carom_body_id_equal(info[i].other, floor);
+        assert_int_equal(self[i], on_lid ? 0 : 1);
+        assert_int_equal(other[i], on_lid ? 1 : -1);
+    }
+    assert_int_equal(with_lid, 1);
+    assert_true(with_floor >= 1 && with_lid + with_floor == n);
+    /* from the lid's side: its child 1 on a's child 0; one array may be NULL */
+    assert_int_equal(carom_body_get_contact_children(w, lid, self, other, 8), 1);
+    assert_int_equal(self[0], 1);
+    assert_int_equal(other[0], 0);
+    other[0] = -7;
+    assert_int_equal(carom_body_get_contact_children(w, lid, NULL, other, 8), 1);
+    assert_int_equal(other[0], 0);
+    self[0] = -7;
+    assert_int_equal(carom_body_get_contact_children(w, lid, self, NULL, 1), 1);
+    assert_int_equal(self[0], 1);
+    assert_int_equal(carom_body_get_contact_children(w, lid, NULL, NULL, 0), 1);
+    /* bad input as body_get_contacts */
+    assert_int_equal(carom_body_get_contact_children(NULL, a, self, other, 8), -1);
+    assert_int_equal(carom_body_get_contact_children(w, a, self, other, -1), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "body_get_contact_children: bad output array"));
+    assert_int_equal(carom_body_get_contact_children(w, a, self, other, 8), n);
+    assert_int_equal(carom_body_get_contact_children(w, a, NULL, NULL, 8), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "body_get_contact_children: bad output array"));
+    carom_body_destroy(w, lid);
+    assert_int_equal(carom_body_get_contact_children(w, lid, self, other, 8), -1);
+    assert_non_null(strstr(carom_world_last_error(w), "body_get_contact_children: body has been destroyed"));
+    carom_world_destroy(w);
+}
+
 static void expect_refused(carom_world *w, const carom_compound_child *c, int n, const char *words)
 {
     int before = carom_world_body_count(w);
@@ -385,6 +629,10 @@ int main(void)
         cmocka_unit_test(test_dumbbell_rolls_as_analytic),
         cmocka_unit_test(test_table_stands_on_mesh),
         cmocka_unit_test(test_child_in_ray_casts_and_events),
+        cmocka_unit_test(test_ray_cast_all_names_children),
+        cmocka_unit_test(test_shape_cast_names_child),
+        cmocka_unit_test(test_overlap_names_lowest_child),
+        cmocka_unit_test(test_contact_children),
         cmocka_unit_test(test_plain_events_beside_compound_name_none),
         cmocka_unit_test(test_bad_compounds_refused),
     };

@@ -14,6 +14,7 @@
 #include <cmocka.h>
 #include "carom/carom.h"
 #include "helpers.h"
+#include "mesh_scenes.h"
 #include "world.h"
 #include "compound.h"
 #include "narrowphase.h"
@@ -788,6 +789,80 @@ static void test_queries_against_a_mesh(void **state)
     carom_world_destroy(w);
 }
 
+/* The parts of level geometry the _child(ren) queries name: a 2 x 2 m mesh
+ * of 1 m cells at z = 1 over x, y in [0, 2], its 8 triangles listed in
+ * reverse (cell (i, j)'s triangle below its diagonal, x > y in the cell, is
+ * 2 (2 j + i), the one above it 2 (2 j + i) + 1, given as 7 minus that: the
+ * index named is the one given, not the tree's), over a flat height field
+ * at z = 0 of 3 x 4 points, 1 m cells, centred on (1.5, 1). */
+static void test_level_parts_named(void **state)
+{
+    (void)state;
+    double verts[9 * 3];
+    int tris[8 * 3];
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            double *v = &verts[3 * (j * 3 + i)];
+            v[0] = i; v[1] = j; v[2] = 1;
+        }
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int a = j * 3 + i, b = a + 1, c = a + 4, d = a + 3, k = 2 * (2 * j + i);
+            int *below = &tris[3 * (7 - k)], *above = &tris[3 * (7 - (k + 1))];
+            below[0] = a; below[1] = b; below[2] = c;
+            above[0] = a; above[1] = c; above[2] = d;
+        }
+    carom_world *w = world_no_gravity();
+    carom_quat q = {1, 0, 0, 0};
+    carom_body_id mesh = scene_add_mesh(w, verts, 9, tris, 8, vec(0, 0, 0), q);
+    carom_body_id field = scene_add_flat_field(w, 3, 4, 1.0, 0.0, vec(1.5, 1, 0));
+    assert_false(carom_body_id_is_null(mesh) || carom_body_id_is_null(field));
+    /* down at (1.3, 1.8): the mesh's cell (1, 1) above its diagonal, given
+     * as 7 - 7 = 0; the field's cell column 1, row 1, upper half: 2 (1 * 3 + 1) + 1 */
+    carom_ray_hit hits[2];
+    int children[2] = {-7, -7};
+    carom_vec3 from = {1.3, 1.8, 5}, down = {0, 0, -10};
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, down, NULL, hits, children, 2), 2);
+    assert_true(carom_body_id_equal(hits[0].body, mesh) && carom_body_id_equal(hits[1].body, field));
+    assert_int_equal(children[0], 0);
+    assert_int_equal(children[1], 9);
+    int child = -7;
+    assert_int_equal(carom_world_ray_cast_child(w, from, down, &hits[0], &child), 1);
+    assert_int_equal(child, 0);
+    /* at (1.7, 0.2): the mesh's cell (1, 0) below its diagonal, 7 - 2 = 5;
+     * the field's cell column 1, row 0, lower half: 2 */
+    from = vec(1.7, 0.2, 5);
+    assert_int_equal(carom_world_ray_cast_all_children(w, from, down, NULL, hits, children, 2), 2);
+    assert_int_equal(children[0], 5);
+    assert_int_equal(children[1], 2);
+    /* a ball of radius 0.1 swept down at (1.3, 1.8) lands inside the same
+     * triangle (0.35 from the diagonal, 0.2 from the cell's edges) */
+    carom_shape_def ball = carom_shape_sphere(0.1);
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(1.3, 1.8, 5), q, down, NULL, &hits[0], &child), 1);
+    assert_true(carom_body_id_equal(hits[0].body, mesh));
+    assert_int_equal(child, 0);
+    check_abs(hits[0].fraction, 3.9 / 10, 1e-9, "ball onto the mesh");
+    /* beyond the mesh (x > 2) it lands on the field: column 2, row 0, lower half */
+    assert_int_equal(carom_world_shape_cast_child(w, &ball, vec(2.7, 0.2, 5), q, down, NULL, &hits[0], &child), 1);
+    assert_true(carom_body_id_equal(hits[0].body, field));
+    assert_int_equal(child, 2 * 2 + 0);
+    /* a flat box over cell (1, 0) overlaps both its triangles (given as 5
+     * and 4): the lower, 4; at z = 0 the field's cell column 1, row 0: 2 */
+    carom_shape_def slab = carom_shape_box(0.4, 0.4, 0.05);
+    carom_body_id ids[2];
+    assert_int_equal(carom_world_overlap_children(w, &slab, vec(1.5, 0.5, 1), q, NULL, ids, children, 2), 1);
+    assert_true(carom_body_id_equal(ids[0], mesh));
+    assert_int_equal(children[0], 4);
+    assert_int_equal(carom_world_overlap_children(w, &slab, vec(1.5, 0.5, 0), q, NULL, ids, children, 2), 1);
+    assert_true(carom_body_id_equal(ids[0], field));
+    assert_int_equal(children[0], 2);
+    /* one over the whole mesh: its triangle 0 */
+    carom_shape_def wide = carom_shape_box(0.9, 0.9, 0.05);
+    assert_int_equal(carom_world_overlap_children(w, &wide, vec(1, 1, 1), q, NULL, ids, children, 2), 1);
+    assert_int_equal(children[0], 0);
+    carom_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -803,6 +878,7 @@ int main(void)
         cmocka_unit_test(test_ray_cast_all_and_filters),
         cmocka_unit_test(test_bad_input_leaves_world_unchanged),
         cmocka_unit_test(test_queries_against_a_mesh),
+        cmocka_unit_test(test_level_parts_named),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -896,6 +896,43 @@ CAROM_API carom_status carom_fixed_step(double dt, int max_steps, double frame_t
  * the world is left exactly as it was. */
 CAROM_API carom_status carom_world_restore_into(carom_world *world, const void *data, size_t size);
 
+/* ---- which part was hit: ray casts, shape casts, overlaps, contacts ------- */
+
+/* These name the part of a body a query or contact is on, as
+ * carom_world_ray_cast_child does: the child index of a compound, the
+ * triangle index of a mesh (as given at creation), the cell of a height
+ * field times 2 plus its triangle (0 lower, 1 upper); -1 for other shapes.
+ * Each checks its input and fails as its sibling without _child(ren) does.
+ * Where a ray starts inside a compound, these name the lowest-index child
+ * holding its origin (carom_world_ray_cast_child names none there, -1). */
+
+/* carom_world_ray_cast_all, and in children[i] (children may be NULL) the
+ * part hits[i] is on. */
+CAROM_API int carom_world_ray_cast_all_children(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
+                                                const carom_query_filter *filter, carom_ray_hit *hits, int *children,
+                                                int capacity);
+/* carom_world_shape_cast, and in *child (child may be NULL) the part the
+ * sweep first touches (of several touched at the same fraction, one of them:
+ * the lowest-index child of a compound). */
+CAROM_API int carom_world_shape_cast_child(const carom_world *world, const carom_shape_def *shape,
+                                           carom_vec3 position, carom_quat orientation, carom_vec3 translation,
+                                           const carom_query_filter *filter, carom_ray_hit *hit, int *child);
+/* carom_world_overlap (the same bodies, one entry each, in the same order),
+ * and in children[i] (children may be NULL) the lowest-index part of ids[i]
+ * the shape overlaps. */
+CAROM_API int carom_world_overlap_children(const carom_world *world, const carom_shape_def *shape,
+                                           carom_vec3 position, carom_quat orientation,
+                                           const carom_query_filter *filter, carom_body_id *ids, int *children,
+                                           int capacity);
+/* For each contact carom_body_get_contacts lists (the same count and
+ * order), the compound child of the body asked about (children_self) and of
+ * the other (children_other) it is between: -1 where that body is not a
+ * compound (a contact with a mesh or height field spans triangles: none is
+ * named). Either array may be NULL, not both when capacity > 0. Returns the
+ * total count; -1 on bad input. */
+CAROM_API int carom_body_get_contact_children(const carom_world *world, carom_body_id id, int *children_self,
+                                              int *children_other, int capacity);
+
 #ifdef __cplusplus
 }
 #endif
