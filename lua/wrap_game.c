@@ -180,9 +180,17 @@ static int query_error(lua_State *L, clua_world *lw, int arg, const char *fname)
     return clua_arg_error(L, arg, fname, "%s", clua_copy_error(lw->world, buf, sizeof buf));
 }
 
-static void push_hit(lua_State *L, const carom_ray_hit *h)
+/* t.key = the 1-based part index when there is one (C's -1: none, nil). */
+static void set_part(lua_State *L, const char *key, int part)
 {
-    lua_createtable(L, 0, 4);
+    if (part < 0) return;
+    lua_pushinteger(L, (lua_Integer)part + 1);
+    lua_setfield(L, -2, key);
+}
+
+static void push_hit(lua_State *L, const carom_ray_hit *h, int child)
+{
+    lua_createtable(L, 0, 5);
     clua_push_body(L, 1, h->body);
     lua_setfield(L, -2, "body");
     clua_push_vec3_table(L, h->point);
@@ -191,12 +199,14 @@ static void push_hit(lua_State *L, const carom_ray_hit *h)
     lua_setfield(L, -2, "normal");
     lua_pushnumber(L, h->fraction);
     lua_setfield(L, -2, "fraction");
+    set_part(L, "child", child);
 }
 
 /* ---- world queries -------------------------------------------------------------- */
 
 /* world:ray_cast_all(origin, translation [, mask or fn]): hits nearest first,
- * each {body=, point=, normal=, fraction=}. */
+ * each {body=, point=, normal=, fraction=, child=} (child: the part hit as
+ * in world:ray_cast, 1-based; nil for one-part shapes). */
 static int world_ray_cast_all(lua_State *L)
 {
     const char *fname = "ray_cast_all";
@@ -208,24 +218,26 @@ static int world_ray_cast_all(lua_State *L)
     lua_filter lf;
     read_query_filter(L, next, fname, &filter, &lf);
     lw = clua_check_world(L, 1, fname);
-    int n = carom_world_ray_cast_all(lw->world, origin, translation, &filter, NULL, 0);
+    int n = carom_world_ray_cast_all_children(lw->world, origin, translation, &filter, NULL, NULL, 0);
     finish_query_filter(L, &lf);
     if (n < 0) return query_error(L, lw, 2, fname);
     carom_ray_hit *hits = lua_newuserdatauv(L, sizeof *hits * (size_t)(n > 0 ? n : 1), 0);
+    int *children = lua_newuserdatauv(L, sizeof *children * (size_t)(n > 0 ? n : 1), 0);
     lw = clua_check_world(L, 1, fname);
-    int got = carom_world_ray_cast_all(lw->world, origin, translation, &filter, hits, n);
+    int got = carom_world_ray_cast_all_children(lw->world, origin, translation, &filter, hits, children, n);
     finish_query_filter(L, &lf);
     if (got > n) got = n;
     lua_createtable(L, got > 0 ? got : 0, 0);
     for (int i = 0; i < got; i++) {
-        push_hit(L, &hits[i]);
+        push_hit(L, &hits[i], children[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;
 }
 
 /* world:shape_cast(shape, position, orientation, translation [, mask or fn]):
- * body, fraction, point, normal of the first hit, or nil. */
+ * body, fraction, point, normal, child of the first hit (child as in
+ * world:ray_cast: the part touched, 1-based, nil for one-part shapes), or nil. */
 static int world_shape_cast(lua_State *L)
 {
     const char *fname = "shape_cast";
@@ -241,7 +253,8 @@ static int world_shape_cast(lua_State *L)
     read_query_filter(L, next, fname, &filter, &lf);
     lw = clua_check_world(L, 1, fname);
     carom_ray_hit hit;
-    int r = carom_world_shape_cast(lw->world, shape, position, orientation, translation, &filter, &hit);
+    int child = -1;
+    int r = carom_world_shape_cast_child(lw->world, shape, position, orientation, translation, &filter, &hit, &child);
     finish_query_filter(L, &lf);
     if (r < 0) return query_error(L, lw, 2, fname);
     if (r == 0) {
@@ -252,11 +265,15 @@ static int world_shape_cast(lua_State *L)
     lua_pushnumber(L, hit.fraction);
     clua_push_vec3_table(L, hit.point);
     clua_push_vec3_table(L, hit.normal);
-    return 4;
+    if (child >= 0) lua_pushinteger(L, (lua_Integer)child + 1);
+    else lua_pushnil(L);
+    return 5;
 }
 
 /* world:overlap(shape, position, orientation [, mask or fn]): the bodies
- * whose shapes overlap it, in id order. */
+ * whose shapes overlap it, in id order, and a second table: children[i] is
+ * the lowest part of bodies[i] overlapped (1-based, as world:ray_cast's
+ * child), nil where bodies[i] is one part (so the table may have holes). */
 static int world_overlap(lua_State *L)
 {
     const char *fname = "overlap";
@@ -270,20 +287,25 @@ static int world_overlap(lua_State *L)
     lua_filter lf;
     read_query_filter(L, next, fname, &filter, &lf);
     lw = clua_check_world(L, 1, fname);
-    int n = carom_world_overlap(lw->world, shape, position, orientation, &filter, NULL, 0);
+    int n = carom_world_overlap_children(lw->world, shape, position, orientation, &filter, NULL, NULL, 0);
     finish_query_filter(L, &lf);
     if (n < 0) return query_error(L, lw, 2, fname);
     carom_body_id *ids = lua_newuserdatauv(L, sizeof *ids * (size_t)(n > 0 ? n : 1), 0);
+    int *children = lua_newuserdatauv(L, sizeof *children * (size_t)(n > 0 ? n : 1), 0);
     lw = clua_check_world(L, 1, fname);
-    int got = carom_world_overlap(lw->world, shape, position, orientation, &filter, ids, n);
+    int got = carom_world_overlap_children(lw->world, shape, position, orientation, &filter, ids, children, n);
     finish_query_filter(L, &lf);
     if (got > n) got = n;
     lua_createtable(L, got > 0 ? got : 0, 0);
+    lua_createtable(L, 0, 0);
     for (int i = 0; i < got; i++) {
         clua_push_body(L, 1, ids[i]);
+        lua_rawseti(L, -3, i + 1);
+        if (children[i] < 0) continue;
+        lua_pushinteger(L, (lua_Integer)children[i] + 1);
         lua_rawseti(L, -2, i + 1);
     }
-    return 1;
+    return 2;
 }
 
 /* world:distance(a, b): distance (negative when they overlap), point on a,
@@ -432,7 +454,10 @@ static int body_is_sensor(lua_State *L)
 }
 
 /* body:contacts(): the touching contacts, each {other=, normal=, point=,
- * separation=, points=, impulse=} (normal from this body to other). */
+ * separation=, points=, impulse=, child=, other_child=} (normal from this
+ * body to other; child and other_child: the compound child of this body and
+ * of other the contact is between, 1-based, nil where that one is not a
+ * compound). */
 static int body_contacts(lua_State *L)
 {
     carom_body_id id;
@@ -440,14 +465,18 @@ static int body_contacts(lua_State *L)
     int n = carom_body_get_contacts(w, id, NULL, 0);
     if (n < 0) n = 0;
     carom_contact_info *info = lua_newuserdatauv(L, sizeof *info * (size_t)(n > 0 ? n : 1), 0);
+    int *mine = lua_newuserdatauv(L, sizeof *mine * 2 * (size_t)(n > 0 ? n : 1), 0), *theirs = mine + (n > 0 ? n : 1);
     w = clua_check_body_id(L, 1, "contacts", &id);
     int got = carom_body_get_contacts(w, id, info, n);
     if (got > n) got = n;
+    /* the same contacts in the same order: nothing ran in between */
+    if (carom_body_get_contact_children(w, id, mine, theirs, got) < 0)
+        for (int i = 0; i < got; i++) mine[i] = theirs[i] = -1;
     lua_getiuservalue(L, 1, BODY_UV_WORLD);
     int world_index = lua_gettop(L);
     lua_createtable(L, got > 0 ? got : 0, 0);
     for (int i = 0; i < got; i++) {
-        lua_createtable(L, 0, 6);
+        lua_createtable(L, 0, 8);
         clua_push_body(L, world_index, info[i].other);
         lua_setfield(L, -2, "other");
         clua_push_vec3_table(L, info[i].normal);
@@ -460,6 +489,8 @@ static int body_contacts(lua_State *L)
         lua_setfield(L, -2, "points");
         lua_pushnumber(L, info[i].normal_impulse);
         lua_setfield(L, -2, "impulse");
+        set_part(L, "child", mine[i]);
+        set_part(L, "other_child", theirs[i]);
         lua_rawseti(L, -2, i + 1);
     }
     return 1;

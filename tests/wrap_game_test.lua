@@ -284,4 +284,73 @@ test("set_pair_filter: contacts and continuous collision, errors raised by step"
   w2:step(1/60)
 end)
 
+test("the part hit, 1-based: ray_cast_all, shape_cast, overlap and contacts name compound children", function()
+  local w = carom.world{ gravity = {0, 0, 0} }
+  -- three spheres of radius 0.25 at x = -1, 0, 1 (children 1, 2, 3)
+  local function spheres(at)
+    local c = {}
+    for i = 1, 3 do c[i] = { shape = carom.sphere{ radius = 0.25 }, position = {i - 2, 0, 0} } end
+    return w:add_body{ type = "static", shape = carom.compound(c), position = at }
+  end
+  local a, b = spheres{0, 0, 0}, spheres{2, 5, 0}
+  local plain = w:add_body{ type = "static", shape = carom.sphere{ radius = 0.25 }, position = {1, 8, 0} }
+  -- along +y at x = 1: a's child 3, b's child 1 (at x = 2 - 1), the plain sphere
+  local hits = w:ray_cast_all({1, -3, 0}, {0, 12, 0})
+  assert(#hits == 3, #hits .. " hits")
+  assert(hits[1].body == a and hits[1].child == 3, "a: child " .. tostring(hits[1].child))
+  assert(hits[2].body == b and hits[2].child == 1, "b: child " .. tostring(hits[2].child))
+  assert(hits[3].body == plain and hits[3].child == nil, "a sphere has no parts")
+  near(hits[2].fraction, 7.75 / 12, 1e-12, "b's fraction")
+  -- a ball swept along +x touches a's child 1 first (at x = -1.5: fraction 1.5 / 6);
+  -- down at x = 0.6 it passes child 2 and lands on child 3 (0.3 above its centre)
+  local ball = carom.sphere{ radius = 0.25 }
+  local body, fraction, _, _, child = w:shape_cast(ball, {-3, 0, 0}, nil, {6, 0, 0})
+  assert(body == a and child == 1, "swept along +x: child " .. tostring(child))
+  near(fraction, 0.25, 1e-9, "along +x")
+  body, fraction, _, _, child = w:shape_cast(ball, {0.6, 0, 3}, nil, {0, 0, -6})
+  assert(body == a and child == 3, "swept down: child " .. tostring(child))
+  near(fraction, 2.7 / 6, 1e-9, "down")
+  body, _, _, _, child = w:shape_cast(ball, {1, 8, 3}, nil, {0, 0, -6})
+  assert(body == plain and child == nil)
+  -- overlap: the second table names the lowest part overlapped, nil for one-part bodies
+  local bodies, children = w:overlap(carom.box{ half_extents = {0.3, 0.3, 0.3} }, {0.5, 0, 0})
+  assert(#bodies == 1 and bodies[1] == a and children[1] == 2, "children 2 and 3 overlapped: " .. tostring(children[1]))
+  bodies, children = w:overlap(carom.box{ half_extents = {0.3, 4.5, 0.3} }, {1, 4, 0})
+  assert(#bodies == 3 and bodies[1] == a and bodies[2] == b and bodies[3] == plain)
+  assert(children[1] == 3 and children[2] == 1 and children[3] == nil)
+  bodies, children = w:overlap(carom.box{ half_extents = {0.3, 0.3, 0.3} }, {0, 0, 5})
+  assert(#bodies == 0 and next(children) == nil)
+
+  -- contacts: a floor of two boxes (child 1 under x > 0, child 2 under x < 0),
+  -- a compound (child 1 a ball on top, child 2 a slab) on child 1, a ball on child 2
+  local g = carom.world{}
+  local floor = g:add_body{ type = "static", shape = carom.compound{
+    { shape = carom.box{ half_extents = {1, 1, 0.5} }, position = {1, 0, -0.5} },
+    { shape = carom.box{ half_extents = {1, 1, 0.5} }, position = {-1, 0, -0.5} } } }
+  local slab = g:add_body{ shape = carom.compound{
+    { shape = carom.sphere{ radius = 0.2 }, position = {0, 0, 0.3} },
+    { shape = carom.box{ half_extents = {0.3, 0.3, 0.1} } } }, position = {1, 0, 0.1} }
+  local lone = g:add_body{ shape = carom.sphere{ radius = 0.25 }, position = {-1, 0, 0.25} }
+  g:step(1 / 60, 30)
+  local cs = slab:contacts()
+  assert(#cs >= 1)
+  for _, c in ipairs(cs) do
+    assert(c.other == floor and c.child == 2 and c.other_child == 1,
+           "slab: " .. tostring(c.child) .. " on " .. tostring(c.other_child))
+  end
+  cs = lone:contacts()
+  assert(#cs == 1 and cs[1].other == floor and cs[1].child == nil and cs[1].other_child == 2)
+  local under_slab, under_ball = 0, 0
+  for _, c in ipairs(floor:contacts()) do
+    if c.other == slab then
+      under_slab = under_slab + 1
+      assert(c.child == 1 and c.other_child == 2)
+    else
+      under_ball = under_ball + 1
+      assert(c.other == lone and c.child == 2 and c.other_child == nil)
+    end
+  end
+  assert(under_slab == #slab:contacts() and under_ball == 1)
+end)
+
 T.finish()

@@ -160,4 +160,33 @@ test("compound: mass, a table standing on a mesh, the child in ray casts and eve
   raises("unknown option", carom.compound, { { shape = carom.sphere{ radius = 1 }, colour = 1 } })
 end)
 
+test("the part of level geometry in ray_cast_all, shape_cast and overlap: triangle and cell, 1-based", function()
+  local world = carom.world{ gravity = {0, 0, 0} }
+  -- a 2 x 2 grid of 1 m cells at z = 1 (cells from x, y = -1): cell (i, j)'s triangle
+  -- below its diagonal is 2 (2 j + i) + 1 in the list, the one above it the next
+  local v, t = grid(2)
+  local mesh = world:add_body{ type = "static", shape = carom.mesh{ vertices = v, triangles = t }, position = {0, 0, 1} }
+  -- 3 rows x 4 columns of 1 m cells centred on the origin at z = 0: cell (column c, row r)
+  -- is 3 r + c + 1, its lower half 2 (3 r + c) + 1, its upper half the next
+  local field = world:add_body{ type = "static", shape = carom.heightfield{ heights = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+                                                                         rows = 3, columns = 4, cell = {1, 1} } }
+  -- at (0.7, -0.9): the mesh's cell (1, 0) below its diagonal (0.7, 0.1 into the cell), 3; the field's
+  -- column 2, row 0 (x in [0.5, 1.5]: 0.2, 0.1 into the cell), its lower half, 2 (3 * 0 + 2) + 1 = 5
+  local hits = world:ray_cast_all({0.7, -0.9, 5}, {0, 0, -10})
+  assert(#hits == 2 and hits[1].body == mesh and hits[2].body == field)
+  assert(hits[1].child == 3, "triangle " .. tostring(hits[1].child))
+  assert(hits[2].child == 5, "field part " .. tostring(hits[2].child))
+  local _, _, _, _, child = world:ray_cast({0.7, -0.9, 5}, {0, 0, -10})
+  assert(child == 3)
+  -- at (0.3, -0.1): the field's column 1, row 0, upper half (0.8, 0.9 into the cell), 2 (3 * 0 + 1) + 2 = 4
+  hits = world:ray_cast_all({0.3, -0.1, 5}, {0, 0, -10})
+  assert(#hits == 2 and hits[2].child == 4, "field part " .. tostring(hits[2].child))
+  -- a small ball swept down at (-0.7, 0.8): the mesh's cell (0, 1) above its diagonal, 2 * 2 + 2 = 6
+  local body, _, _, _, part = world:shape_cast(carom.sphere{ radius = 0.05 }, {-0.7, 0.8, 5}, nil, {0, 0, -10})
+  assert(body == mesh and part == 6, "swept onto triangle " .. tostring(part))
+  -- a flat box over the mesh's cell (1, 1): triangles 7 and 8, the lower named
+  local bodies, children = world:overlap(carom.box{ half_extents = {0.4, 0.4, 0.05} }, {0.5, 0.5, 1})
+  assert(#bodies == 1 and bodies[1] == mesh and children[1] == 7, "overlap: " .. tostring(children[1]))
+end)
+
 T.finish()
