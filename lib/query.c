@@ -395,6 +395,38 @@ static int overlap_part(const gjk_proxy *a, const gjk_proxy *b)
     return o.part;
 }
 
+typedef struct nearest_triangle {
+    gjk_proxy point;          /* the point, in the mesh's frame */
+    double distance;          /* to the nearest triangle so far */
+    int part;                 /* that triangle, -1: none yet */
+} nearest_triangle;
+
+static int visit_nearest_triangle(void *ctx, const vec3 v[3], unsigned active_edges, uint32_t index)
+{
+    (void)active_edges;
+    nearest_triangle *q = ctx;
+    gjk_proxy tri = {NULL, v, 3, q->point.x};
+    double d = gjk_distance(&q->point, &tri).distance;
+    /* a point on a shared edge: the lower index, whatever the tree's order */
+    if (q->part < 0 || d < q->distance || (d == q->distance && index < (uint32_t)q->part)) {
+        q->distance = d;
+        q->part = (int)index;
+    }
+    return 1;
+}
+
+int query_triangle_near(const shape *s, xform x, vec3 p, double reach)
+{
+    if (!is_triangles(s)) return -1;
+    vec3 local = xf_inv_point(x, p);
+    nearest_triangle q = {{NULL, &local, 1, {v3_zero(), q_identity()}}, INFINITY, -1};
+    vec3 r = v3(reach, reach, reach);
+    aabb box = {v3_sub(local, r), v3_add(local, r)};
+    if (s->type == SHAPE_MESH) mesh_query(s->mesh, box, visit_nearest_triangle, &q);
+    else heightfield_query(s->field, box, visit_nearest_triangle, &q);
+    return q.part;
+}
+
 int query_shapes_overlap(const shape *a, xform xa, const shape *b, xform xb)
 {
     if (a->type == SHAPE_PLANE || is_triangles(a)) { /* the convex one (or a compound) first */

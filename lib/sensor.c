@@ -184,6 +184,25 @@ static int touching_contact_of(const contact *c, int me)
     return (c->id_a == me || c->id_b == me) && (c->flags & CONTACT_TOUCHING);
 }
 
+static int deepest_point(const manifold *m)
+{
+    int deepest = 0;
+    for (int p = 1; p < m->count; p++)
+        if (m->points[p].separation < m->points[deepest].separation) deepest = p;
+    return deepest;
+}
+
+/* The part of the body at slot a contact names: its compound child by the
+ * sub, or the triangle of a mesh or height field nearest the manifold's
+ * deepest point (the point carom_body_get_contacts reports; midway between
+ * the surfaces, so within half its separation of the triangle). */
+static int contact_part(const body_store *s, int slot, int child, const manifold *m)
+{
+    if (child >= 0 || m->count == 0) return child;
+    const manifold_point *p = &m->points[deepest_point(m)];
+    return query_triangle_near(&s->shapes[slot], body_xform(s, slot), p->point, fabs(p->separation) + 0.01);
+}
+
 CAROM_API int carom_body_get_contacts(const carom_world *w, carom_body_id id, carom_contact_info *out, int capacity)
 {
     if (!w) return -1;
@@ -201,12 +220,9 @@ CAROM_API int carom_body_get_contacts(const carom_world *w, carom_body_id id, ca
             ci->other = world_make_id(w, flip ? c->id_a : c->id_b);
             ci->normal = from_v3(flip ? v3_neg(d->m.normal) : d->m.normal);
             ci->point_count = d->m.count;
-            int deepest = 0;
+            int deepest = deepest_point(&d->m);
             double impulse = 0;
-            for (int p = 0; p < d->m.count; p++) {
-                if (d->m.points[p].separation < d->m.points[deepest].separation) deepest = p;
-                impulse += d->state[p].normal_impulse;
-            }
+            for (int p = 0; p < d->m.count; p++) impulse += d->state[p].normal_impulse;
             ci->point = from_v3(d->m.points[deepest].point);
             ci->separation = d->m.points[deepest].separation;
             /* the state keeps the sub-step impulse (warm start): times the
@@ -234,7 +250,12 @@ CAROM_API int carom_body_get_contact_children(const carom_world *w, carom_body_i
             /* the contact's sub names the child pair, as for its events */
             int ca = -1, cb = -1;
             int sa = s->ids[c->id_a].slot, sb = s->ids[c->id_b].slot;
-            if (sa >= 0 && sb >= 0) compound_sub_children(&s->shapes[sa], &s->shapes[sb], c->sub, &ca, &cb);
+            if (sa >= 0 && sb >= 0) {
+                const manifold *m = &CONTACT_DATA(cs, i)->m;
+                compound_sub_children(&s->shapes[sa], &s->shapes[sb], c->sub, &ca, &cb);
+                ca = contact_part(s, sa, ca, m);
+                cb = contact_part(s, sb, cb, m);
+            }
             int flip = c->id_b == me;
             if (children_self) children_self[count] = flip ? cb : ca;
             if (children_other) children_other[count] = flip ? ca : cb;

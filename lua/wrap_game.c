@@ -455,9 +455,9 @@ static int body_is_sensor(lua_State *L)
 
 /* body:contacts(): the touching contacts, each {other=, normal=, point=,
  * separation=, points=, impulse=, child=, other_child=} (normal from this
- * body to other; child and other_child: the compound child of this body and
- * of other the contact is between, 1-based, nil where that one is not a
- * compound). */
+ * body to other; child and other_child: the part of this body and of other
+ * the contact is on, as carom_body_get_contact_children names it, 1-based,
+ * nil for one-part shapes). */
 static int body_contacts(lua_State *L)
 {
     carom_body_id id;

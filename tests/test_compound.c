@@ -440,6 +440,20 @@ static void test_overlap_names_lowest_child(void **state)
     carom_world_destroy(w);
 }
 
+/* A static 4 x 4 grid of 1 m cells centred on the origin at z = 0 (32
+ * triangles: *triangle_count). */
+static carom_body_id add_grid_floor(carom_world *w, int *triangle_count)
+{
+    double *v;
+    int nv, *t;
+    scene_grid(4, 1.0, 0.0, 0, &v, &nv, &t, triangle_count);
+    carom_quat q = {1, 0, 0, 0};
+    carom_body_id floor = scene_add_mesh(w, v, nv, t, *triangle_count, vec(0, 0, 0), q);
+    free(v);
+    free(t);
+    return floor;
+}
+
 /* carom_body_get_contact_children: a compound (child 0 a ball on top,
  * child 1 a slab under it, child 2 a ball off the slab's edge, clear of
  * the floor)
@@ -451,13 +465,8 @@ static void test_contact_children(void **state)
 {
     (void)state;
     carom_world *w = world_default();
-    double *v;
-    int nv, *t, nt;
-    scene_grid(4, 1.0, 0.0, 0, &v, &nv, &t, &nt);
-    carom_quat q = {1, 0, 0, 0};
-    carom_body_id floor = scene_add_mesh(w, v, nv, t, nt, vec(0, 0, 0), q);
-    free(v);
-    free(t);
+    int nt;
+    carom_body_id floor = add_grid_floor(w, &nt);
     carom_compound_child c[3];
     c[0] = carom_compound_child_default(carom_shape_sphere(0.2));
     c[0].position.z = 0.3;
@@ -476,7 +485,7 @@ static void test_contact_children(void **state)
     for (int i = 0; i < n; i++) {
         assert_true(carom_body_id_equal(info[i].other, floor));
         assert_int_equal(self[i], 1);
-        assert_int_equal(other[i], -1);
+        assert_true(other[i] >= 0 && other[i] < nt); /* a triangle: which, test_contact_names_triangle */
     }
     /* the plate's underside on the top ball (its top at 0.1 + 0.3 + 0.2 up, less what it sank) */
     carom_vec3 at = pos(w, a);
@@ -494,7 +503,8 @@ static void test_contact_children(void **state)
         with_lid += on_lid;
         with_floor += carom_body_id_equal(info[i].other, floor);
         assert_int_equal(self[i], on_lid ? 0 : 1);
-        assert_int_equal(other[i], on_lid ? 1 : -1);
+        if (on_lid) assert_int_equal(other[i], 1);
+        else assert_true(other[i] >= 0 && other[i] < nt);
     }
     assert_int_equal(with_lid, 1);
     assert_true(with_floor >= 1 && with_lid + with_floor == n);
@@ -519,6 +529,54 @@ static void test_contact_children(void **state)
     carom_body_destroy(w, lid);
     assert_int_equal(carom_body_get_contact_children(w, lid, self, other, 8), -1);
     assert_non_null(strstr(carom_world_last_error(w), "body_get_contact_children: body has been destroyed"));
+    carom_world_destroy(w);
+}
+
+/* A dumbbell (children 0 and 1, balls of radius 0.1 at x = -0.5 and 0.5 of
+ * (0.3, 0.2)) resting on a 4 x 4 grid of 1 m cells centred on the origin,
+ * cell (i, j) at x in [i - 2, i - 1], y in [j - 2, j - 1], its triangles
+ * 2 (4 j + i) below the diagonal (x > y in the cell), + 1 above: ball 0
+ * at (-0.2, 0.2) is over cell (1, 2) 0.8, 0.2 in, triangle 18; ball 1 at
+ * (0.8, 0.2) over cell (2, 2), triangle 20. A ball on a 5 x 5 height field
+ * centred on (10, 0) at (10.3, -0.6): column 2, row 1 (0.3, 0.4 in: above
+ * the diagonal), 2 (4 * 1 + 2) + 1 = 13. Events still name no triangle. */
+static void test_contact_names_triangle(void **state)
+{
+    (void)state;
+    carom_world *w = world_default();
+    int nt;
+    carom_body_id floor = add_grid_floor(w, &nt);
+    carom_body_id field = scene_add_flat_field(w, 5, 5, 1.0, 0.0, vec(10, 0, 0));
+    carom_compound_child c[2];
+    for (int i = 0; i < 2; i++) {
+        c[i] = carom_compound_child_default(carom_shape_sphere(0.1));
+        c[i].position.x = i - 0.5;
+    }
+    carom_body_id bell = add_compound(w, c, 2, CAROM_BODY_DYNAMIC, vec(0.3, 0.2, 0.1));
+    carom_body_id ball = add_sphere(w, 10.3, -0.6, 0.25, 0.25);
+    assert_false(carom_body_id_is_null(floor) || carom_body_id_is_null(field) || carom_body_id_is_null(bell));
+    int named_in_events = 0;
+    for (int k = 0; k < 30; k++) {
+        carom_world_step(w, DT);
+        const carom_contact_event *ev;
+        int n = carom_world_get_events(w, &ev);
+        for (int e = 0; e < n; e++) {
+            int ca, cb;
+            carom_world_get_event_children(w, e, &ca, &cb);
+            named_in_events += carom_body_id_equal(ev[e].a, floor) ? ca >= 0 : carom_body_id_equal(ev[e].b, floor) ? cb >= 0 : 0;
+        }
+    }
+    assert_int_equal(named_in_events, 0);
+    int self[4], other[4];
+    assert_int_equal(carom_body_get_contact_children(w, bell, self, other, 4), 2);
+    for (int i = 0; i < 2; i++) assert_int_equal(other[i], self[i] == 0 ? 18 : 20);
+    assert_true(self[0] != self[1]);
+    /* from the mesh's side the same pairs, turned round */
+    assert_int_equal(carom_body_get_contact_children(w, floor, self, other, 4), 2);
+    for (int i = 0; i < 2; i++) assert_int_equal(self[i], other[i] == 0 ? 18 : 20);
+    assert_int_equal(carom_body_get_contact_children(w, ball, self, other, 4), 1);
+    assert_int_equal(self[0], -1);
+    assert_int_equal(other[0], 13);
     carom_world_destroy(w);
 }
 
@@ -633,6 +691,7 @@ int main(void)
         cmocka_unit_test(test_shape_cast_names_child),
         cmocka_unit_test(test_overlap_names_lowest_child),
         cmocka_unit_test(test_contact_children),
+        cmocka_unit_test(test_contact_names_triangle),
         cmocka_unit_test(test_plain_events_beside_compound_name_none),
         cmocka_unit_test(test_bad_compounds_refused),
     };

@@ -187,6 +187,14 @@ test("the part of level geometry in ray_cast_all, shape_cast and overlap: triang
   -- a flat box over the mesh's cell (1, 1): triangles 7 and 8, the lower named
   local bodies, children = world:overlap(carom.box{ half_extents = {0.4, 0.4, 0.05} }, {0.5, 0.5, 1})
   assert(#bodies == 1 and bodies[1] == mesh and children[1] == 7, "overlap: " .. tostring(children[1]))
+  -- a ball touching the mesh at (0.7, -0.9): its contact names triangle 3 as other_child
+  local ball = world:add_body{ shape = carom.sphere{ radius = 0.25 }, position = {0.7, -0.9, 1.249} }
+  world:step(1 / 60)
+  local cs = ball:contacts()
+  assert(#cs == 1 and cs[1].other == mesh and cs[1].child == nil and cs[1].other_child == 3,
+         "contact: " .. tostring(cs[1] and cs[1].other_child))
+  cs = mesh:contacts()
+  assert(#cs == 1 and cs[1].child == 3 and cs[1].other_child == nil)
 end)
 
 T.finish()

@@ -925,10 +925,12 @@ CAROM_API int carom_world_overlap_children(const carom_world *world, const carom
                                            const carom_query_filter *filter, carom_body_id *ids, int *children,
                                            int capacity);
 /* For each contact carom_body_get_contacts lists (the same count and
- * order), the compound child of the body asked about (children_self) and of
- * the other (children_other) it is between: -1 where that body is not a
- * compound (a contact with a mesh or height field spans triangles: none is
- * named). Either array may be NULL, not both when capacity > 0. Returns the
+ * order), the part of the body asked about (children_self) and of the other
+ * (children_other) it is on: a compound's child, and for a mesh or height
+ * field the triangle nearest the contact's point (carom_contact_info.point,
+ * at the body's pose now; the lower index where two are as near), which a
+ * manifold spanning several triangles does not keep itself (events name
+ * none). Either array may be NULL, not both when capacity > 0. Returns the
  * total count; -1 on bad input. */
 CAROM_API int carom_body_get_contact_children(const carom_world *world, carom_body_id id, int *children_self,
                                               int *children_other, int capacity);
