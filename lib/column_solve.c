@@ -89,7 +89,16 @@ static int next_of(const step_context *ctx, const int *first, const int *second,
     return far_c == far_o ? -1 : o; /* two manifolds between one pair: no column */
 }
 
-int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count)
+/* How heavy-on-light manifold c is: 0, COLUMN_HEAVY or COLUMN_VERY_HEAVY. */
+static int heaviness(const step_context *ctx, const contact_constraint *c)
+{
+    double ia = ctx->bodies[c->a].inv_mass, ib = ctx->bodies[c->b].inv_mass;
+    double lo = dmin(ia, ib), hi = dmax(ia, ib); /* (a static body: lo 0, never heavy-on-light) */
+    if (!(lo > 0.0) || hi < SHOCK_MASS_RATIO * lo) return 0;
+    return hi >= COLUMN_VERY_HEAVY_RATIO * lo ? COLUMN_VERY_HEAVY : COLUMN_HEAVY;
+}
+
+int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count, int heavy_on_light)
 {
     m->count = 0;
     if (!ctx->blocks || ctx->penalty || scalar_count < 1) return 1;
@@ -100,9 +109,13 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
     int stiffens = ctx->warm_starting && ctx->gravity_length > 0.0;
     const contact_constraint *cc = ctx->constraints;
     int nb = ctx->body_count, ncon = ctx->constraint_count;
-    for (int k = 0; k < scalar_count; k++) ctx->blocks[scalar ? scalar[k] : k].column = 0;
+    for (int k = 0; k < scalar_count; k++) {
+        contact_block *blk = &ctx->blocks[scalar ? scalar[k] : k];
+        blk->column = blk->heavy_column = 0;
+    }
     double unit_sag = column_unit_sag(ctx);
-    if (!stiffens || !column_counts(scalar_count, unit_sag)) return 1;
+    heavy_on_light = heavy_on_light && scalar_count >= COLUMN_MIN_HEAVY;
+    if (!stiffens || (!heavy_on_light && !column_counts(scalar_count, unit_sag))) return 1;
     if (!array_reserve(&m->scratch, &m->scratch_capacity, 3 * nb + 2 * ncon, sizeof(int))) return 0;
     int *first = (int *)m->scratch, *second = first + nb, *deg = second + nb, *elig = deg + nb, *seen = elig + ncon;
     for (int b = 0; b < nb; b++) first[b] = second[b] = -1, deg[b] = 0;
@@ -142,7 +155,12 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
             s = cc[o].a == s ? cc[o].b : cc[o].a;
             cur = o;
         }
-        if (!column_counts(links - begin, unit_sag)) {
+        int heavy = 0;
+        for (int i = begin; heavy_on_light && i < links; i++) {
+            int h = heaviness(ctx, &cc[((const column_link *)m->links)[i].con]);
+            if (h > heavy) heavy = h;
+        }
+        if (!(heavy && links - begin >= COLUMN_MIN_HEAVY) && !column_counts(links - begin, unit_sag)) {
             links = begin;
             continue;
         }
@@ -153,8 +171,18 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
     }
     const int *start = (const int *)m->start;
     const column_link *link = (const column_link *)m->links;
-    for (int k = 0; k < m->count; k++)
-        for (int i = start[k]; i < start[k + 1]; i++) ctx->blocks[link[i].con].column = 1;
+    for (int k = 0; k < m->count; k++) {
+        int heavy = 0;
+        for (int i = start[k]; heavy_on_light && i < start[k + 1]; i++) {
+            int h = heaviness(ctx, &cc[link[i].con]);
+            if (h > heavy) heavy = h;
+        }
+        if (start[k + 1] - start[k] < COLUMN_MIN_HEAVY) heavy = 0;
+        for (int i = start[k]; i < start[k + 1]; i++) {
+            ctx->blocks[link[i].con].column = 1;
+            ctx->blocks[link[i].con].heavy_column = heavy;
+        }
+    }
     return 1;
 }
 

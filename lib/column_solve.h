@@ -34,11 +34,23 @@ typedef struct column_memory {
 
 void column_memory_free(column_memory *m);
 
+/* Two bodies whose masses differ by this factor or more are a heavy body on
+ * a light one (solver.c's shock pass takes such pairs). */
+#define SHOCK_MASS_RATIO 4.0
+/* A column of at least COLUMN_MIN_HEAVY manifolds with a heavy-on-light
+ * one is solved directly whatever its sag, and the shock pass leaves it
+ * alone (contact_block.heavy_column: COLUMN_HEAVY; COLUMN_VERY_HEAVY where
+ * some pair's masses differ by COLUMN_VERY_HEAVY_RATIO or more). */
+#define COLUMN_MIN_HEAVY 3
+#define COLUMN_VERY_HEAVY_RATIO 50.0
+enum { COLUMN_HEAVY = 1, COLUMN_VERY_HEAVY = 2 };
+
 /* Finds the step's columns among the manifolds the scalar passes take
  * (scalar: their indices, NULL for all) and marks their blocks
- * (contact_block.column) before contact_prepare reads the mark; 0 on out
- * of memory. */
-int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count);
+ * (contact_block.column, heavy_column) before contact_prepare reads the
+ * marks; heavy_on_light: some manifold of the step is heavy-on-light. 0 on
+ * out of memory. */
+int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count, int heavy_on_light);
 /* After contact_prepare: the couplings; a column with a manifold that has
  * no block is left to the manifolds' own solves. Returns how many stiff
  * manifolds (contact_block.stiff) the columns hold. */

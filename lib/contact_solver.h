@@ -18,6 +18,8 @@ typedef struct contact_block {
     int shock_ready;
     int stiff;                   /* springs past a quarter of the sub-step rate: swept again (contact_solve_normals) */
     int column;                  /* in a column solved directly (column_solve.c; set before prepare) */
+    int heavy_column;            /* that column holds a heavy-on-light manifold: COLUMN_HEAVY, or
+                                    COLUMN_VERY_HEAVY (column_solve.h); 0 otherwise */
     int column_done;             /* this pass's normal rows already solved by its column */
     int friction_first;          /* every point warm-started pressed and sticking: friction rows first (solve_manifold) */
 } contact_block;

@@ -46,7 +46,6 @@
  * interleave its contacts (red-black), so support climbs two boxes per sweep
  * instead of the whole stack. */
 #define WIDE_MIN_CONSTRAINTS 64
-#define SHOCK_MASS_RATIO 4.0
 
 /* What the stages hand each other besides the step context. */
 typedef struct solver_work {
@@ -1034,6 +1033,10 @@ static void shock_pass(const step_context *ctx, const solver_work *work, int use
 {
     for (int o = 0; o < work->shock_count; o++) {
         contact_constraint *c = &ctx->constraints[work->shock_order[o]];
+        /* a heavy column's normal rows are solved exactly (column_solve.c):
+         * held immovable, its light bodies' rocking would be fed into the
+         * heavy one (a 100 kg box on two 1 kg boxes fell at every preset) */
+        if (c->wide_batch < 0 && ctx->blocks && ctx->blocks[work->shock_order[o]].heavy_column) continue;
         if (c->wide_batch >= 0) wide_read_impulses(work->wide, c);
         contact_solve_shock(c, ctx, use_bias, hold_bounces, work->level[c->a] < work->level[c->b]);
     }
@@ -1387,7 +1390,7 @@ int world_solve(carom_world *w, step_context *ctx)
     plan_shock(ctx, &work);
     if (!plan_wide(w, ctx, &work) || !attach_rows(w, ctx, &work)) return 0;
     work.columns = &w->scratch.solver.columns;
-    if (!column_find(work.columns, ctx, work.scalar, work.scalar_count)) return 0;
+    if (!column_find(work.columns, ctx, work.scalar, work.scalar_count, work.heavy_on_light)) return 0;
     prepare_points(ctx, &work);
     work.stiff -= column_prepare(work.columns, ctx);
     if (!check_penalty(w, ctx)) return -1;
