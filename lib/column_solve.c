@@ -190,6 +190,19 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
 static vec3 arm_at(const contact_constraint *c, int i, int s) { return c->b == s ? c->r[i].rb_n : c->r[i].ra_n; }
 static vec3 response_at(const contact_constraint *c, int i, int s) { return c->b == s ? c->r[i].ib_n : c->r[i].ia_n; }
 
+int column_keep_heavy_scalar(column_memory *m, const step_context *ctx)
+{
+    if (!column_find(m, ctx, NULL, ctx->constraint_count, 1)) return 0;
+    const int *start = (const int *)m->start;
+    const column_link *link = (const column_link *)m->links;
+    for (int k = 0; k < m->count; k++)
+        for (int i = start[k]; i < start[k + 1]; i++)
+            if (ctx->blocks[link[i].con].heavy_column) ctx->constraints[link[i].con].keep_scalar = 1;
+    for (int k = 0; ctx->blocks && k < ctx->constraint_count; k++) ctx->blocks[k].column = ctx->blocks[k].heavy_column = 0;
+    m->count = 0;
+    return 1;
+}
+
 int column_prepare(column_memory *m, const step_context *ctx)
 {
     int held = 0;

@@ -51,6 +51,12 @@ enum { COLUMN_HEAVY = 1, COLUMN_VERY_HEAVY = 2 };
  * marks; heavy_on_light: some manifold of the step is heavy-on-light. 0 on
  * out of memory. */
 int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count, int heavy_on_light);
+/* Before the wide passes are planned, in a step with a heavy-on-light
+ * manifold: marks the manifolds of every heavy column among all of them
+ * (contact_constraint.keep_scalar), so that the scalar passes take them and
+ * column_find finds them again; the blocks' marks are cleared after. 0 on
+ * out of memory. */
+int column_keep_heavy_scalar(column_memory *m, const step_context *ctx);
 /* After contact_prepare: the couplings; a column with a manifold that has
  * no block is left to the manifolds' own solves. Returns how many stiff
  * manifolds (contact_block.stiff) the columns hold. */

@@ -64,6 +64,7 @@ typedef struct contact_constraint {
      * their own) */
     int locked;
     int spinless;                /* neither body can turn (static or rotation-locked): no angular terms */
+    int keep_scalar;             /* in a heavy column (column_solve.c): the scalar passes take it */
     vec3 n, t1, t2;
     double friction, restitution;
     double rolling;              /* rolling resistance (0: no rolling rows, the manifold may go wide) */

@@ -396,6 +396,7 @@ static void fill_constraint(carom_world *w, const step_context *ctx, const load_
                 (bodies[c->a].inv_mass > 0.0 && (bs->flags[sa] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sa]) > 0.0) |
                 (bodies[c->b].inv_mass > 0.0 && (bs->flags[sb] & BODY_LOCK_PLANE) && v3_len2(bs->plane_normal[sb]) > 0.0) << 1;
     c->spinless = 0; /* mark_spinless, where some body is rotation-locked */
+    c->keep_scalar = 0; /* plan_wide, where a heavy column would go wide */
     c->an = NULL;
     c->r = NULL;
     c->spring = NULL;
@@ -882,6 +883,9 @@ static int plan_wide(carom_world *w, const step_context *ctx, solver_work *work)
     work->scalar = NULL;
     work->scalar_count = ctx->constraint_count;
     if (ctx->penalty || ctx->constraint_count < WIDE_MIN_CONSTRAINTS) return 1;
+    /* towers under a heavy body stay scalar, so that column_find finds them
+     * (a tower among 80 other boxes fell as it did without columns) */
+    if (work->heavy_on_light && !column_keep_heavy_scalar(&s->solver.columns, ctx)) return 0;
     if (!s->solver.wide_env) s->solver.wide_env = wide_read_env(); /* once per world, not a getenv a step */
     work->wide = wide_plan(&s->solver.wide, &s->solver.wide_capacity, ctx->constraints, ctx->constraint_count,
                            work->locked > 0 || s->solver.rotation_locked, ctx->body_count, s->solver.wide_env,

@@ -342,7 +342,7 @@ static void color_manifolds(wide_set *ws, contact_constraint *cc, int ncon, int 
         int c = 0;
         while (c < WIDE_COLORS && (taken >> c & 1u)) c++;
         cc[k].wide_batch = cc[k].wide_lane = -1;
-        if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1 || cc[k].rolling > 0.0) {
+        if (!WIDE_VECTORS || c == WIDE_COLORS || cc[k].count < 1 || cc[k].rolling > 0.0 || cc[k].keep_scalar) {
             bucket[k] = -1;
             ws->overflow[ws->overflow_count++] = k;
             continue;
