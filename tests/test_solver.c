@@ -742,13 +742,7 @@ static void test_heavy_tops_on_towers(void **state)
     for (int p = 0; p < 3; p++) {
         carom_world_def wd = preset_def(presets[p]);
         wd.enable_sleep = 0;
-        carom_world *w = carom_world_create(&wd);
-        assert_non_null(w);
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.shape = carom_shape_plane(0, 0, 1, 0);
-        g.friction = 0.6;
-        add_body(w, &g);
+        carom_world *w = world_with(wd, 1, 0.6, 0.0);
         carom_body_id tower[5];
         for (int i = 0; i < 5; i++) tower[i] = add_box(w, 0, 0, 0.5 + i, 0.5, i == 4 ? 10.0 : 1.0, 0.6);
         for (int e = 0; e < 80; e++) add_box(w, 3 + (e % 10), -5 + (e / 10), 0.3, 0.3, 1.0, 0.6);
