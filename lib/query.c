@@ -110,10 +110,9 @@ static int compound_child_containing(const compound *c, vec3 p)
 
 /* Ray origin + t dir, t in [0, max_t], against the body at slot (world
  * frame). Starts inside: t = 0, normal against the ray, and *part the
- * compound child holding the origin when name_inside (else -1: what
- * carom_world_ray_cast_child has always answered). */
-static int ray_body(const body_store *s, int slot, vec3 origin, vec3 dir, double max_t, int name_inside, double *t,
-                    vec3 *normal, int *part)
+ * compound child holding the origin (-1 for other shapes). */
+static int ray_body(const body_store *s, int slot, vec3 origin, vec3 dir, double max_t, double *t, vec3 *normal,
+                    int *part)
 {
     const shape *sh = &s->shapes[slot];
     *part = -1;
@@ -123,7 +122,7 @@ static int ray_body(const body_store *s, int slot, vec3 origin, vec3 dir, double
     if (sh->type == SHAPE_COMPOUND ? inside_child >= 0 : shape_contains_local(sh, o)) {
         *t = 0.0;
         *normal = v3_neg(v3_normalize(dir));
-        if (name_inside) *part = inside_child;
+        *part = inside_child;
         return 1;
     }
     double t0 = 0.0;
@@ -515,7 +514,6 @@ typedef struct ray_hits {
     part_hit *items;
     int count, capacity;
     int all, failed;
-    int name_inside;          /* a ray starting inside a compound names the child holding its origin */
     part_hit best;
 } ray_hits;
 
@@ -527,7 +525,7 @@ static double ray_visit(void *ctx, int id_index, vec3 origin, vec3 dir, double m
     double t;
     vec3 n;
     int part;
-    if (slot < 0 || !ray_body(s, slot, origin, dir, h->all ? 1.0 : max_t, h->name_inside, &t, &n, &part))
+    if (slot < 0 || !ray_body(s, slot, origin, dir, h->all ? 1.0 : max_t, &t, &n, &part))
         return max_t;
     if (!body_visible(&h->q, id_index)) return max_t;
     part_hit hit;
@@ -559,7 +557,7 @@ static int check_ray(const carom_world *w, const char *fn, carom_vec3 origin, ca
 /* The closest hit and its part (child may be NULL): the public closest-hit
  * casts, their checks and messages under fn. */
 static int ray_cast_closest(const carom_world *w, const char *fn, carom_vec3 origin, carom_vec3 translation,
-                            const carom_query_filter *filter, int name_inside, carom_ray_hit *hit, int *child)
+                            const carom_query_filter *filter, carom_ray_hit *hit, int *child)
 {
     if (child) *child = -1;
     if (!w) return -1;
@@ -571,7 +569,6 @@ static int ray_cast_closest(const carom_world *w, const char *fn, carom_vec3 ori
     memset(&h, 0, sizeof h);
     h.q.w = w;
     h.q.filter = filter;
-    h.name_inside = name_inside;
     int was = query_lock(w);
     bp_ray_cast(w->bp, to_v3(origin), to_v3(translation), 1.0, ray_visit, &h);
     query_unlock(w, was);
@@ -585,7 +582,7 @@ static int ray_cast_closest(const carom_world *w, const char *fn, carom_vec3 ori
 CAROM_API int carom_world_ray_cast_filtered(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
                                             const carom_query_filter *filter, carom_ray_hit *hit)
 {
-    return ray_cast_closest(w, "ray_cast", origin, translation, filter, 0, hit, NULL);
+    return ray_cast_closest(w, "ray_cast", origin, translation, filter, hit, NULL);
 }
 
 CAROM_API int carom_world_ray_cast(const carom_world *w, carom_vec3 origin, carom_vec3 translation, carom_ray_hit *hit)
@@ -596,7 +593,7 @@ CAROM_API int carom_world_ray_cast(const carom_world *w, carom_vec3 origin, caro
 CAROM_API int carom_world_ray_cast_child(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
                                          carom_ray_hit *hit, int *child)
 {
-    return ray_cast_closest(w, "ray_cast_child", origin, translation, NULL, 0, hit, child);
+    return ray_cast_closest(w, "ray_cast_child", origin, translation, NULL, hit, child);
 }
 
 static int compare_hits(const void *pa, const void *pb)
@@ -608,8 +605,7 @@ static int compare_hits(const void *pa, const void *pb)
 
 /* Every hit, nearest first, and the part of each (children may be NULL). */
 static int ray_cast_every(const carom_world *w, const char *fn, carom_vec3 origin, carom_vec3 translation,
-                          const carom_query_filter *filter, int name_inside, carom_ray_hit *hits, int *children,
-                          int capacity)
+                          const carom_query_filter *filter, carom_ray_hit *hits, int *children, int capacity)
 {
     if (!w) return -1;
     if (capacity < 0 || (capacity > 0 && !hits))
@@ -621,7 +617,6 @@ static int ray_cast_every(const carom_world *w, const char *fn, carom_vec3 origi
     h.q.w = w;
     h.q.filter = filter;
     h.all = 1;
-    h.name_inside = name_inside;
     int was = query_lock(w);
     bp_ray_cast(w->bp, to_v3(origin), to_v3(translation), 1.0, ray_visit, &h);
     query_unlock(w, was);
@@ -641,14 +636,14 @@ static int ray_cast_every(const carom_world *w, const char *fn, carom_vec3 origi
 CAROM_API int carom_world_ray_cast_all(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
                                        const carom_query_filter *filter, carom_ray_hit *hits, int capacity)
 {
-    return ray_cast_every(w, "ray_cast_all", origin, translation, filter, 0, hits, NULL, capacity);
+    return ray_cast_every(w, "ray_cast_all", origin, translation, filter, hits, NULL, capacity);
 }
 
 CAROM_API int carom_world_ray_cast_all_children(const carom_world *w, carom_vec3 origin, carom_vec3 translation,
                                                 const carom_query_filter *filter, carom_ray_hit *hits, int *children,
                                                 int capacity)
 {
-    return ray_cast_every(w, "ray_cast_all_children", origin, translation, filter, 1, hits, children, capacity);
+    return ray_cast_every(w, "ray_cast_all_children", origin, translation, filter, hits, children, capacity);
 }
 
 /* ---- shape casts, overlaps, distances ----------------------------------------- */

@@ -329,15 +329,16 @@ static void test_ray_cast_all_names_children(void **state)
     assert_int_equal(carom_world_ray_cast_all_children(w, from, along, &f, hits, children, 3), 2);
     assert_int_equal(children[0], 0);
     assert_int_equal(children[1], -1);
-    /* starting inside A's child 0: fraction 0 on child 0 (ray_cast_child
-     * has always named no child there) */
+    /* starting inside A's child 0: fraction 0 on child 0, from every call
+     * that names parts (ray_cast_child named none there, -1, before) */
     carom_vec3 inside = {-1, 0.1, 0}, up = {0, 0, 2};
     assert_int_equal(carom_world_ray_cast_all_children(w, inside, up, NULL, hits, children, 3), 1);
     assert_true(carom_body_id_equal(hits[0].body, a) && hits[0].fraction == 0.0);
     assert_int_equal(children[0], 0);
     int child = -7;
     assert_int_equal(carom_world_ray_cast_child(w, inside, up, hits, &child), 1);
-    assert_int_equal(child, -1);
+    assert_true(carom_body_id_equal(hits[0].body, a) && hits[0].fraction == 0.0);
+    assert_int_equal(child, 0);
     /* bad input as ray_cast_all */
     assert_int_equal(carom_world_ray_cast_all_children(NULL, from, along, NULL, hits, children, 3), -1);
     assert_int_equal(carom_world_ray_cast_all_children(w, from, along, NULL, hits, children, -1), -1);

@@ -138,6 +138,9 @@ test("compound: mass, a table standing on a mesh, the child in ray casts and eve
   -- a ray down through the top names child 1, one down a leg's corner child 3 (x > 0, y < 0)
   local hit, point, normal, fraction, child = world:ray_cast({0.2, 0.1, 3}, {0, 0, -5})
   assert(hit == tbl and child == 1, "top: child " .. tostring(child))
+  -- a ray starting inside the top names it too, at fraction 0
+  local ihit, _, _, ifraction, ichild = world:ray_cast({x, y, z + 0.73}, {0, 0, 2})
+  assert(ihit == tbl and ifraction == 0 and ichild == 1, "inside the top: child " .. tostring(ichild))
   local events = {}
   local w2 = carom.world{}
   w2:add_body{ type = "static", shape = carom.plane{} }

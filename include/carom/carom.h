@@ -599,8 +599,9 @@ CAROM_API int carom_world_query_aabb(const carom_world *world, carom_vec3 lo, ca
 /* ---- level geometry and compound bodies --------------------------------- */
 
 /* carom_world_ray_cast, and which part of the body was hit: the child index
- * of a compound, the triangle index of a mesh (as given at creation), the
- * cell of a height field times 2 plus its triangle (0 lower, 1 upper);
+ * of a compound (for a ray starting inside it, the lowest-index child
+ * holding the origin), the triangle index of a mesh (as given at creation),
+ * the cell of a height field times 2 plus its triangle (0 lower, 1 upper);
  * -1 for other shapes. child may be NULL. */
 CAROM_API int carom_world_ray_cast_child(const carom_world *world, carom_vec3 origin, carom_vec3 translation,
                                          carom_ray_hit *hit, int *child);
@@ -903,8 +904,8 @@ CAROM_API carom_status carom_world_restore_into(carom_world *world, const void *
  * triangle index of a mesh (as given at creation), the cell of a height
  * field times 2 plus its triangle (0 lower, 1 upper); -1 for other shapes.
  * Each checks its input and fails as its sibling without _child(ren) does.
- * Where a ray starts inside a compound, these name the lowest-index child
- * holding its origin (carom_world_ray_cast_child names none there, -1). */
+ * Where a ray starts inside a compound, these (and carom_world_ray_cast_child)
+ * name the lowest-index child holding its origin. */
 
 /* carom_world_ray_cast_all, and in children[i] (children may be NULL) the
  * part hits[i] is on. */
