@@ -591,6 +591,94 @@ static void expect_refused(carom_world *w, const carom_compound_child *c, int n,
     assert_non_null(strstr(carom_world_last_error(w), words));
 }
 
+/* Each child's own friction (issue #18): a wide flat box with a small box
+ * on top of it, one body, sliding down a 30 deg slope (gravity tilted;
+ * ground friction 1, mixed sqrt(a b)) on the flat child alone. It slides at
+ * a = g (sin(theta) - mu cos(theta)) with mu the flat child's: 0.1 (4.055
+ * m/s^2) with the top child at 0.3, and 0.3 (2.356) the other way round
+ * (one friction for both children would fail one of the two; the body's
+ * default 0.6 would hold it). Every preset, dt 1/60 and 1/240. (Both
+ * children on the ground would not do: how a rigid body's load divides
+ * between two faces is not fixed by its balance, the solver's springs
+ * decide it.) */
+static void test_children_keep_their_friction(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const double theta = 30.0 * 3.141592653589793 / 180.0, g = 9.81;
+    for (int p = 0; p < 3; p++)
+        for (int rev = 0; rev < 2; rev++)
+            for (int k = 0; k < 2; k++) {
+                double dt = k ? 1.0 / 240 : 1.0 / 60;
+                carom_world_def wd = preset_def(presets[p]);
+                wd.gravity.x = g * sin(theta);
+                wd.gravity.z = -g * cos(theta);
+                wd.enable_sleep = 0;
+                carom_world *w = world_with(wd, 1, 1.0, 0.0);
+                double mu[2] = {rev ? 0.3 : 0.1, rev ? 0.1 : 0.3}; /* [0] the flat child on the ground */
+                carom_compound_child c[2] = {carom_compound_child_default(carom_shape_box(0.5, 0.5, 0.1)),
+                                             carom_compound_child_default(carom_shape_box(0.1, 0.1, 0.1))};
+                c[1].position = vec(0, 0, 0.2);
+                for (int i = 0; i < 2; i++) c[i].friction = mu[i] * mu[i]; /* sqrt(1 * mu^2) = mu against the ground */
+                carom_body_id b = add_compound(w, c, 2, CAROM_BODY_DYNAMIC, vec(0, 0, 0.1));
+                assert_false(carom_body_id_is_null(b));
+                double want = g * (sin(theta) - mu[0] * cos(theta));
+                /* past the first contact's settling, the speed gained over 1 s */
+                int steps = (int)(0.25 / dt + 0.5), more = (int)(1.0 / dt + 0.5);
+                for (int s = 0; s < steps; s++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+                carom_vec3 v0, v1;
+                carom_body_get_linear_velocity(w, b, &v0);
+                for (int s = 0; s < more; s++) assert_int_equal(carom_world_step(w, dt), CAROM_OK);
+                carom_body_get_linear_velocity(w, b, &v1);
+                double got = (v1.x - v0.x) / (more * dt);
+                print_message("%s dt 1/%.0f mu %.1f on the ground, %.1f above: a %.5f m/s^2 (want %.5f)\n", presets[p],
+                              1 / dt, mu[0], mu[1], got, want);
+                near_rel(got, want, 1e-3, "sliding acceleration");
+                carom_world_destroy(w);
+            }
+}
+
+/* Each child's own restitution: a dumbbell held upright (its axis vertical)
+ * drops 1 m onto a plane of restitution 0 (mixed max(a, b)): only the lower
+ * child touches, under the centre of mass, so the body leaves at e times its
+ * impact speed, e the lower child's, with no spin. Upright both ways, every
+ * preset. */
+static void test_children_keep_their_restitution(void **state)
+{
+    (void)state;
+    const char *presets[] = {"fast", "default", "accurate"};
+    const double e[2] = {0.3, 0.8};
+    for (int p = 0; p < 3; p++)
+        for (int low = 0; low < 2; low++) {
+            carom_world_def wd = preset_def(presets[p]);
+            carom_world *w = world_with(wd, 1, 0.6, 0.0);
+            carom_compound_child c[2];
+            for (int i = 0; i < 2; i++) {
+                c[i] = carom_compound_child_default(carom_shape_sphere(0.1));
+                c[i].position = vec(0, 0, i == low ? -0.4 : 0.4);
+                c[i].restitution = e[i];
+            }
+            carom_body_id b = add_compound(w, c, 2, CAROM_BODY_DYNAMIC, vec(0, 0, 1.5));
+            assert_false(carom_body_id_is_null(b));
+            /* the fastest fall and the fastest rise after it */
+            double down = 0, up = 0;
+            for (int s = 0; s < 120; s++) {
+                assert_int_equal(carom_world_step(w, 1.0 / 240), CAROM_OK);
+                carom_vec3 v;
+                carom_body_get_linear_velocity(w, b, &v);
+                if (up == 0 && -v.z > down) down = -v.z;
+                if (v.z > up) up = v.z;
+            }
+            carom_vec3 spin;
+            carom_body_get_angular_velocity(w, b, &spin);
+            print_message("%s, child %d (e %.1f) below: down %.4f m/s, up %.4f m/s, ratio %.4f\n", presets[p], low, e[low],
+                          down, up, up / down);
+            near_rel(up / down, e[low], 0.02, "bounce ratio");
+            assert_true(fabs(spin.x) + fabs(spin.y) < 1e-9);
+            carom_world_destroy(w);
+        }
+}
+
 /* Events of plain pairs name no child, before and after a compound's in the
  * same step (the children are kept only up to the last event naming one). */
 static void test_plain_events_beside_compound_name_none(void **state)
@@ -693,6 +781,8 @@ int main(void)
         cmocka_unit_test(test_overlap_names_lowest_child),
         cmocka_unit_test(test_contact_children),
         cmocka_unit_test(test_contact_names_triangle),
+        cmocka_unit_test(test_children_keep_their_friction),
+        cmocka_unit_test(test_children_keep_their_restitution),
         cmocka_unit_test(test_plain_events_beside_compound_name_none),
         cmocka_unit_test(test_bad_compounds_refused),
     };
