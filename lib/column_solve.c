@@ -98,6 +98,18 @@ static int heaviness(const step_context *ctx, const contact_constraint *c)
     return hi >= COLUMN_VERY_HEAVY_RATIO * lo ? COLUMN_VERY_HEAVY : COLUMN_HEAVY;
 }
 
+/* The heaviest of links begin .. end - 1, as contact_block.heavy_column:
+ * 0 for a column shorter than COLUMN_MIN_HEAVY. */
+static int column_heaviness(const step_context *ctx, const column_link *link, int begin, int end)
+{
+    int heavy = 0;
+    for (int i = begin; end - begin >= COLUMN_MIN_HEAVY && i < end; i++) {
+        int h = heaviness(ctx, &ctx->constraints[link[i].con]);
+        if (h > heavy) heavy = h;
+    }
+    return heavy;
+}
+
 int column_find(column_memory *m, const step_context *ctx, const int *scalar, int scalar_count, int heavy_on_light)
 {
     m->count = 0;
@@ -155,33 +167,20 @@ int column_find(column_memory *m, const step_context *ctx, const int *scalar, in
             s = cc[o].a == s ? cc[o].b : cc[o].a;
             cur = o;
         }
-        int heavy = 0;
-        for (int i = begin; heavy_on_light && i < links; i++) {
-            int h = heaviness(ctx, &cc[((const column_link *)m->links)[i].con]);
-            if (h > heavy) heavy = h;
-        }
-        if (!(heavy && links - begin >= COLUMN_MIN_HEAVY) && !column_counts(links - begin, unit_sag)) {
+        int heavy = heavy_on_light ? column_heaviness(ctx, (const column_link *)m->links, begin, links) : 0;
+        if (!heavy && !column_counts(links - begin, unit_sag)) {
             links = begin;
             continue;
+        }
+        for (int i = begin; i < links; i++) {
+            contact_block *blk = &ctx->blocks[((const column_link *)m->links)[i].con];
+            blk->column = 1;
+            blk->heavy_column = heavy;
         }
         if (!array_reserve(&m->start, &m->start_capacity, m->count + 2, sizeof(int))) return 0;
         int *start = (int *)m->start;
         start[m->count] = begin;
         start[++m->count] = links;
-    }
-    const int *start = (const int *)m->start;
-    const column_link *link = (const column_link *)m->links;
-    for (int k = 0; k < m->count; k++) {
-        int heavy = 0;
-        for (int i = start[k]; heavy_on_light && i < start[k + 1]; i++) {
-            int h = heaviness(ctx, &cc[link[i].con]);
-            if (h > heavy) heavy = h;
-        }
-        if (start[k + 1] - start[k] < COLUMN_MIN_HEAVY) heavy = 0;
-        for (int i = start[k]; i < start[k + 1]; i++) {
-            ctx->blocks[link[i].con].column = 1;
-            ctx->blocks[link[i].con].heavy_column = heavy;
-        }
     }
     return 1;
 }
@@ -193,12 +192,11 @@ static vec3 response_at(const contact_constraint *c, int i, int s) { return c->b
 int column_keep_heavy_scalar(column_memory *m, const step_context *ctx)
 {
     if (!column_find(m, ctx, NULL, ctx->constraint_count, 1)) return 0;
-    const int *start = (const int *)m->start;
-    const column_link *link = (const column_link *)m->links;
-    for (int k = 0; k < m->count; k++)
-        for (int i = start[k]; i < start[k + 1]; i++)
-            if (ctx->blocks[link[i].con].heavy_column) ctx->constraints[link[i].con].keep_scalar = 1;
-    for (int k = 0; ctx->blocks && k < ctx->constraint_count; k++) ctx->blocks[k].column = ctx->blocks[k].heavy_column = 0;
+    for (int k = 0; ctx->blocks && k < ctx->constraint_count; k++) {
+        contact_block *blk = &ctx->blocks[k];
+        if (blk->heavy_column) ctx->constraints[k].keep_scalar = 1;
+        blk->column = blk->heavy_column = 0; /* (column_find marks the scalar ones again) */
+    }
     m->count = 0;
     return 1;
 }

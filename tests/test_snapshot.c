@@ -15,6 +15,7 @@
 #include <cmocka.h>
 #include "carom/carom.h"
 #include "helpers.h"
+#include "mesh_scenes.h"
 #include "snapshot.h" /* internal: snapshot_field_bytes */
 #include "contact.h"  /* internal: the restore path's contact_set_index */
 #include "world.h"    /* internal: which body of a restored pair is A */
@@ -243,25 +244,11 @@ static void test_compounds_restore_at_any_step(void **state)
     (void)state;
     const char *presets[] = {"fast", "default", "accurate"};
     for (int p = 0; p < 3; p++) {
-        carom_world_def wd = carom_world_def_default();
-        assert_int_equal(carom_world_def_apply_preset(&wd, presets[p]), CAROM_OK);
-        carom_world *w = carom_world_create(&wd);
-        carom_body_def g = carom_body_def_default();
-        g.type = CAROM_BODY_STATIC;
-        g.shape = carom_shape_plane(0, 0, 1, 0);
-        carom_body_create(w, &g);
+        carom_world *w = world_with(preset_def(presets[p]), 1, 0.6, 0.0); /* (the default body's material) */
         static const double ramp_v[] = {1, -1, 0.0, 3, -1, 0.0, 3, 1, 0.6, 1, 1, 0.6};
         static const int ramp_t[] = {0, 1, 2, 0, 2, 3};
-        carom_mesh_def md = carom_mesh_def_default();
-        md.vertices = ramp_v;
-        md.vertex_count = 4;
-        md.triangles = ramp_t;
-        md.triangle_count = 2;
-        carom_body_def mb = carom_body_def_default();
-        mb.type = CAROM_BODY_STATIC;
-        mb.shape.type = CAROM_SHAPE_MESH;
-        mb.mesh = &md;
-        assert_false(carom_body_id_is_null(carom_body_create(w, &mb)));
+        const carom_quat identity = {1, 0, 0, 0};
+        assert_false(carom_body_id_is_null(scene_add_mesh(w, ramp_v, 4, ramp_t, 2, vec(0, 0, 0), identity)));
         carom_compound_child bell[2] = {carom_compound_child_default(carom_shape_sphere(0.1)),
                                         carom_compound_child_default(carom_shape_box(0.08, 0.08, 0.08))};
         bell[0].position = vec(-0.3, 0, 0);
